@@ -1,0 +1,1 @@
+//! Reference validation runner (work in progress).

@@ -1,0 +1,2 @@
+//! grainforge task runner.
+fn main() {}
