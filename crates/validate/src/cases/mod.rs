@@ -1,0 +1,23 @@
+//! The case registry: each crate's reproductions plug in here as one module
+//! exposing `cases()` and `EXPECTED_FAILURES`.
+
+use crate::{Case, ExpectedFailure};
+
+mod fixture_integrity;
+mod rounding;
+
+/// Every registered case, in a stable order.
+#[must_use]
+pub fn registry() -> Vec<Case> {
+    let mut cases = Vec::new();
+    cases.extend(fixture_integrity::cases());
+    cases
+}
+
+/// Every known failure with its reason.
+#[must_use]
+pub fn expected_failures() -> Vec<ExpectedFailure> {
+    let mut list = Vec::new();
+    list.extend_from_slice(fixture_integrity::EXPECTED_FAILURES);
+    list
+}

@@ -1,0 +1,389 @@
+//! Tidy checks of the workspace, run by `cargo test` (rust-analyzer's
+//! `xtask/src/tidy.rs`): the layering table, workspace lints, module docs,
+//! manifest conventions, library purity and fixture provenance.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+/// The crate layering (docs/architecture.md, "Architecture Invariant"):
+/// each workspace crate with the internal crates it may depend on, in any
+/// dependency section (normal, dev, build).
+const ALLOWED: &[(&str, &[&str])] = &[
+    // layer 0: no internal dependencies, and neither knows the other
+    ("levelset", &[]),
+    ("sph-harmonics", &[]),
+    // layer 1
+    ("morph-dna", &["levelset", "sph-harmonics"]),
+    // layer 2
+    ("cloner", &["morph-dna", "levelset", "sph-harmonics"]),
+    ("packer-quadtree", &["levelset"]),
+    // layer 3
+    (
+        "validate",
+        &[
+            "levelset",
+            "sph-harmonics",
+            "morph-dna",
+            "cloner",
+            "packer-quadtree",
+        ],
+    ),
+    // layer 4
+    (
+        "xtask",
+        &[
+            "levelset",
+            "sph-harmonics",
+            "morph-dna",
+            "cloner",
+            "packer-quadtree",
+            "validate",
+        ],
+    ),
+];
+
+/// Library crates: no file I/O, environment, clock or printing in `src/`.
+const LIBRARIES: &[&str] = &[
+    "levelset",
+    "sph-harmonics",
+    "morph-dna",
+    "cloner",
+    "packer-quadtree",
+    "validate",
+];
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask sits in the workspace root")
+        .to_path_buf()
+}
+
+fn crate_dir(name: &str) -> PathBuf {
+    if name == "xtask" {
+        root().join("xtask")
+    } else {
+        root().join("crates").join(name)
+    }
+}
+
+fn read(path: &Path) -> String {
+    fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()))
+}
+
+/// A dependency line of a manifest: (section, package name, line).
+#[derive(Debug)]
+struct Dep {
+    section: String,
+    name: String,
+    line: String,
+}
+
+/// Minimal TOML reading, enough for our manifests: the dependency names of
+/// `[dependencies]`, `[dev-dependencies]`, `[build-dependencies]` and their
+/// target-specific forms, and `[dependencies.NAME]` tables.
+fn dependencies(manifest: &str) -> Vec<Dep> {
+    let mut deps = Vec::new();
+    let mut section = String::new();
+    for raw in manifest.lines() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        if line.starts_with('[') {
+            section = line.trim_matches(|c| c == '[' || c == ']').to_owned();
+            // [dependencies.foo] style (also [target.'cfg(..)'.dev-dependencies.foo])
+            let pieces: Vec<&str> = section.split('.').collect();
+            let kind = pieces.iter().position(|p| {
+                matches!(
+                    *p,
+                    "dependencies" | "dev-dependencies" | "build-dependencies"
+                )
+            });
+            if let Some(name) = kind.and_then(|i| pieces.get(i + 1)) {
+                deps.push(Dep {
+                    section: section.clone(),
+                    name: name.trim_matches('"').to_owned(),
+                    line: line.to_owned(),
+                });
+            }
+            continue;
+        }
+        let is_dep_section = ["dependencies", "dev-dependencies", "build-dependencies"]
+            .iter()
+            .any(|k| section == *k || section.ends_with(&format!(".{k}")));
+        if is_dep_section && let Some((key, _)) = line.split_once('=') {
+            let name = key.trim().split('.').next().unwrap_or("");
+            deps.push(Dep {
+                section: section.clone(),
+                name: name.trim_matches('"').to_owned(),
+                line: line.to_owned(),
+            });
+        }
+    }
+    deps
+}
+
+/// The layering violations of one manifest, as "from -> to" messages.
+fn layering_violations(krate: &str, manifest: &str) -> Vec<String> {
+    let internal: Vec<&str> = ALLOWED.iter().map(|(n, _)| *n).collect();
+    let allowed = ALLOWED
+        .iter()
+        .find(|(n, _)| *n == krate)
+        .map(|(_, a)| *a)
+        .unwrap_or(&[]);
+    dependencies(manifest)
+        .into_iter()
+        .filter(|d| internal.contains(&d.name.as_str()) && !allowed.contains(&d.name.as_str()))
+        .map(|d| {
+            format!(
+                "forbidden dependency edge {krate} -> {} (in [{}]; {krate} may depend on: {})",
+                d.name,
+                d.section,
+                if allowed.is_empty() {
+                    "no internal crate".to_owned()
+                } else {
+                    allowed.join(", ")
+                }
+            )
+        })
+        .collect()
+}
+
+fn workspace_crates() -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(root().join("crates"))
+        .expect("crates/ exists")
+        .flatten()
+        .filter(|e| e.path().join("Cargo.toml").exists())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    names.push("xtask".to_owned());
+    names.sort();
+    names
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn every_crate_is_in_the_layering_table() {
+    let listed: Vec<&str> = ALLOWED.iter().map(|(n, _)| *n).collect();
+    for name in workspace_crates() {
+        assert!(
+            listed.contains(&name.as_str()),
+            "crate {name} is not in tidy.rs ALLOWED: add it with its layer (and to docs/architecture.md)"
+        );
+    }
+    for name in listed {
+        assert!(
+            crate_dir(name).join("Cargo.toml").exists(),
+            "ALLOWED names {name}, which does not exist"
+        );
+    }
+}
+
+#[test]
+fn layering_is_respected() {
+    let mut violations = Vec::new();
+    for name in workspace_crates() {
+        let manifest = read(&crate_dir(&name).join("Cargo.toml"));
+        violations.extend(layering_violations(&name, &manifest));
+    }
+    assert!(violations.is_empty(), "{}", violations.join("\n"));
+}
+
+#[test]
+fn layering_check_names_the_forbidden_edge() {
+    let manifest = "[package]\nname = \"levelset\"\n\n[dependencies]\nnalgebra.workspace = true\nsph-harmonics = { workspace = true }\n\n[dev-dependencies.morph-dna]\nworkspace = true\n";
+    let v = layering_violations("levelset", manifest);
+    assert_eq!(v.len(), 2, "{v:?}");
+    assert!(
+        v[0].starts_with("forbidden dependency edge levelset -> sph-harmonics"),
+        "{}",
+        v[0]
+    );
+    assert!(
+        v[1].starts_with("forbidden dependency edge levelset -> morph-dna"),
+        "{}",
+        v[1]
+    );
+    assert!(
+        layering_violations("cloner", "[dependencies]\nmorph-dna.workspace = true\n").is_empty()
+    );
+}
+
+#[test]
+fn every_crate_inherits_workspace_lints_and_package_fields() {
+    for name in workspace_crates() {
+        let manifest = read(&crate_dir(&name).join("Cargo.toml"));
+        let compact: String = manifest
+            .lines()
+            .map(str::trim)
+            .collect::<Vec<_>>()
+            .join("\n");
+        assert!(
+            compact.contains("[lints]\nworkspace = true"),
+            "{name}: add `[lints] workspace = true`"
+        );
+        assert!(
+            compact.contains("version = \"0.0.0\""),
+            "{name}: internal crates are version 0.0.0"
+        );
+        assert!(
+            compact.contains("publish = false"),
+            "{name}: internal crates are publish = false"
+        );
+        assert!(
+            compact.contains(&format!("name = \"{name}\"")),
+            "{name}: folder name = package name"
+        );
+        for field in ["edition.workspace = true", "rust-version.workspace = true"] {
+            assert!(compact.contains(field), "{name}: missing `{field}`");
+        }
+    }
+}
+
+#[test]
+fn every_dependency_version_lives_in_the_workspace() {
+    for name in workspace_crates() {
+        let manifest = read(&crate_dir(&name).join("Cargo.toml"));
+        for dep in dependencies(&manifest) {
+            let ok = dep.line.contains("workspace = true")
+                || dep.line.contains(".workspace=true")
+                || dep.line.starts_with('[');
+            assert!(
+                ok,
+                "{name}: `{}` must use `workspace = true` (versions live in the root Cargo.toml)",
+                dep.line
+            );
+        }
+    }
+}
+
+#[test]
+fn every_module_has_a_doc_comment() {
+    let mut missing = Vec::new();
+    for name in workspace_crates() {
+        let dir = crate_dir(&name);
+        let mut files = Vec::new();
+        for sub in ["src", "benches", "tests", "examples"] {
+            rust_files(&dir.join(sub), &mut files);
+        }
+        if dir.join("build.rs").exists() {
+            files.push(dir.join("build.rs"));
+        }
+        for file in files {
+            let text = read(&file);
+            let first = text
+                .lines()
+                .map(str::trim)
+                .find(|l| !l.is_empty())
+                .unwrap_or("");
+            if !first.starts_with("//!") {
+                missing.push(
+                    file.strip_prefix(root())
+                        .unwrap_or(&file)
+                        .display()
+                        .to_string(),
+                );
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "modules without a `//!` doc:\n{}",
+        missing.join("\n")
+    );
+}
+
+#[test]
+fn libraries_touch_no_files_environment_clock_or_stdout() {
+    let banned = [
+        "std::fs",
+        "File::open",
+        "File::create",
+        "std::env::var",
+        "env::var(",
+        "Instant::now",
+        "SystemTime::now",
+        "println!",
+        "eprintln!",
+        "print!(",
+        "stdout()",
+    ];
+    let mut hits = Vec::new();
+    for name in LIBRARIES {
+        let mut files = Vec::new();
+        rust_files(&crate_dir(name).join("src"), &mut files);
+        for file in files {
+            // unit-test files may print their seeds
+            if file.file_name().is_some_and(|f| f == "tests.rs")
+                || file.components().any(|c| c.as_os_str() == "tests")
+            {
+                continue;
+            }
+            for (i, line) in read(&file).lines().enumerate() {
+                let code = line.split("//").next().unwrap_or("");
+                for b in banned {
+                    if code.contains(b) {
+                        hits.push(format!(
+                            "{}:{}: {b}",
+                            file.strip_prefix(root()).unwrap_or(&file).display(),
+                            i + 1
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        hits.is_empty(),
+        "library code must not do I/O, read the environment or the clock, or print:\n{}",
+        hits.join("\n")
+    );
+}
+
+#[test]
+fn every_fixture_folder_has_a_readme() {
+    let fixtures = root().join("fixtures");
+    let mut missing = Vec::new();
+    for entry in fs::read_dir(&fixtures).expect("fixtures/ exists").flatten() {
+        if entry.path().is_dir() && !entry.path().join("README.md").exists() {
+            missing.push(entry.file_name().to_string_lossy().into_owned());
+        }
+    }
+    assert!(
+        fixtures.join("README.md").exists(),
+        "fixtures/README.md is missing"
+    );
+    assert!(
+        missing.is_empty(),
+        "fixture folders without README.md: {missing:?}"
+    );
+}
+
+#[test]
+fn readme_test_command_is_what_ci_runs() {
+    let readme = read(&root().join("README.md"));
+    let ci = read(&root().join(".ci/run"));
+    let command = "cargo test --workspace";
+    assert!(
+        readme.contains(command),
+        "README.md must name the test command `{command}`"
+    );
+    assert!(
+        ci.contains(command),
+        ".ci/run must run the README's test command `{command}`"
+    );
+}
