@@ -1,0 +1,404 @@
+//! Samplers of univariate and bivariate densities: the seed's
+//! acceptance–rejection (Medina 2018, §2.2) and an exact tabulated
+//! inverse-CDF sampler with marginal and conditional draws.
+//!
+//! Every sampler takes the caller's `rng: &mut impl rand::Rng`; draws depend
+//! only on the generator's stream.
+
+use rand::Rng;
+
+use crate::error::{Error, Result};
+use crate::histogram::{BinAxis, Histogram1d};
+use crate::pdf::{BicubicPdf, TabulatedPdf2d};
+
+/// A bounded bivariate density on a rectangle, as needed by
+/// [`AcceptanceRejection2d`].
+pub trait Density2d {
+    /// The rectangle `((x_min, x_max), (y_min, y_max))` outside which the
+    /// density is zero.
+    fn support(&self) -> ((f64, f64), (f64, f64));
+    /// The density at `(x, y)` (non-negative).
+    fn density(&self, x: f64, y: f64) -> f64;
+    /// An upper bound of [`Density2d::density`] on the support.
+    fn upper_bound(&self) -> f64;
+}
+
+impl Density2d for BicubicPdf {
+    fn support(&self) -> ((f64, f64), (f64, f64)) {
+        let (x, y) = (self.x_axis(), self.y_axis());
+        ((x.min, x.max), (y.min, y.max))
+    }
+    fn density(&self, x: f64, y: f64) -> f64 {
+        BicubicPdf::density(self, x, y)
+    }
+    fn upper_bound(&self) -> f64 {
+        BicubicPdf::upper_bound(self)
+    }
+}
+
+impl Density2d for TabulatedPdf2d {
+    fn support(&self) -> ((f64, f64), (f64, f64)) {
+        ((self.x.min, self.x.max), (self.y.min, self.y.max))
+    }
+    fn density(&self, x: f64, y: f64) -> f64 {
+        self.density_at(x, y)
+    }
+    fn upper_bound(&self) -> f64 {
+        self.max_density()
+    }
+}
+
+/// The seed's Monte Carlo sampler (Medina 2018, §2.2): propose `(x, y)`
+/// uniformly on the support, accept with probability `f(x, y) / M`.
+///
+/// Exact for any density bounded by `M`; the expected number of proposals per
+/// draw is `M · area` ([`AcceptanceRejection2d::expected_trials`]).
+#[derive(Debug, Clone)]
+pub struct AcceptanceRejection2d<D> {
+    pdf: D,
+    x: (f64, f64),
+    y: (f64, f64),
+    bound: f64,
+}
+
+impl<D: Density2d> AcceptanceRejection2d<D> {
+    /// Wraps a density.
+    ///
+    /// # Errors
+    /// [`Error::InvalidRange`] for an empty or non-finite support,
+    /// [`Error::InvalidParameter`] for a bound that is not finite and positive.
+    pub fn new(pdf: D) -> Result<Self> {
+        let (x, y) = pdf.support();
+        for (a, b) in [x, y] {
+            if !(a.is_finite() && b.is_finite() && a < b) {
+                return Err(Error::InvalidRange { min: a, max: b });
+            }
+        }
+        let bound = pdf.upper_bound();
+        if !(bound.is_finite() && bound > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "upper bound",
+                value: bound,
+                reason: "must be finite and positive",
+            });
+        }
+        Ok(Self { pdf, x, y, bound })
+    }
+
+    /// Expected proposals per accepted draw, `M · area`.
+    pub fn expected_trials(&self) -> f64 {
+        self.bound * (self.x.1 - self.x.0) * (self.y.1 - self.y.0)
+    }
+
+    /// The wrapped density.
+    pub fn pdf(&self) -> &D {
+        &self.pdf
+    }
+
+    /// One draw.
+    pub fn sample(&self, rng: &mut impl Rng) -> (f64, f64) {
+        loop {
+            let x = self.x.0 + (self.x.1 - self.x.0) * rng.random::<f64>();
+            let y = self.y.0 + (self.y.1 - self.y.0) * rng.random::<f64>();
+            if rng.random::<f64>() * self.bound < self.pdf.density(x, y) {
+                return (x, y);
+            }
+        }
+    }
+}
+
+/// A discrete CDF over `n` cells with a guide table (Chen & Asau 1974) for
+/// O(1) expected lookup.
+#[derive(Debug, Clone, PartialEq)]
+struct GuidedCdf {
+    /// `cdf[0] = 0`, `cdf[n] = 1`, non-decreasing.
+    cdf: Vec<f64>,
+    /// `guide[g]`: first cell whose upper CDF exceeds `g / n`.
+    guide: Vec<u32>,
+}
+
+impl GuidedCdf {
+    /// From non-negative weights with positive finite sum.
+    fn new(weights: &[f64]) -> Self {
+        let n = weights.len();
+        let total: f64 = weights.iter().sum();
+        let mut cdf = Vec::with_capacity(n + 1);
+        cdf.push(0.0);
+        let mut acc = 0.0;
+        for w in weights {
+            acc += w;
+            cdf.push((acc / total).min(1.0));
+        }
+        // Trailing empty cells keep their exact 1.0; the last positive cell ends at 1.
+        if let Some(last) = weights.iter().rposition(|w| *w > 0.0) {
+            for c in &mut cdf[last + 1..] {
+                *c = 1.0;
+            }
+        }
+        let mut guide = Vec::with_capacity(n);
+        let mut k = 0usize;
+        for g in 0..n {
+            let t = g as f64 / n as f64;
+            while k + 1 < n && cdf[k + 1] <= t {
+                k += 1;
+            }
+            guide.push(k as u32);
+        }
+        Self { cdf, guide }
+    }
+
+    /// Cell `k` with `cdf[k] ≤ u < cdf[k+1]` and the fraction of the way
+    /// through it, for `u ∈ [0, 1)`.
+    #[inline]
+    fn locate(&self, u: f64) -> (usize, f64) {
+        let n = self.guide.len();
+        let g = ((u * n as f64) as usize).min(n - 1);
+        let mut k = self.guide[g] as usize;
+        while k > 0 && self.cdf[k] > u {
+            k -= 1;
+        }
+        while k + 1 < n && self.cdf[k + 1] <= u {
+            k += 1;
+        }
+        let (lo, hi) = (self.cdf[k], self.cdf[k + 1]);
+        let frac = if hi > lo {
+            ((u - lo) / (hi - lo)).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        (k, frac)
+    }
+}
+
+/// Exact inverse-CDF sampler of a piecewise-constant univariate density
+/// (for example a [`Histogram1d`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct InverseCdfSampler1d {
+    axis: BinAxis,
+    cdf: GuidedCdf,
+}
+
+impl InverseCdfSampler1d {
+    /// From non-negative bin weights on `axis`.
+    ///
+    /// # Errors
+    /// Axis errors, [`Error::RaggedTable`] if `weights.len() != axis.bins`,
+    /// [`Error::NonPositive`] for a negative or NaN weight, [`Error::ZeroMass`].
+    pub fn new(axis: BinAxis, weights: &[f64]) -> Result<Self> {
+        axis.validate()?;
+        if weights.len() != axis.bins {
+            return Err(Error::RaggedTable {
+                what: "weights",
+                index: 0,
+                expected: axis.bins,
+                found: weights.len(),
+            });
+        }
+        if let Some(k) = weights.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
+            return Err(Error::NonPositive {
+                what: "weight",
+                index: k,
+                value: weights[k],
+            });
+        }
+        let total: f64 = weights.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return Err(Error::ZeroMass {
+                context: "in the weights".into(),
+            });
+        }
+        Ok(Self {
+            axis,
+            cdf: GuidedCdf::new(weights),
+        })
+    }
+
+    /// The histogram's piecewise-constant density.
+    ///
+    /// # Errors
+    /// As [`InverseCdfSampler1d::new`] (cannot fail for a valid histogram).
+    pub fn from_histogram(h: &Histogram1d) -> Result<Self> {
+        let w: Vec<f64> = h.counts.iter().map(|c| *c as f64).collect();
+        Self::new(h.axis, &w)
+    }
+
+    /// The quantile function at `u ∈ [0, 1)` (clamped into it).
+    pub fn quantile(&self, u: f64) -> f64 {
+        let u = if u.is_nan() {
+            0.0
+        } else {
+            u.clamp(0.0, 1.0 - f64::EPSILON / 2.0)
+        };
+        let (k, f) = self.cdf.locate(u);
+        (self.axis.edge(k) + f * self.axis.width()).min(self.axis.max)
+    }
+
+    /// One draw.
+    pub fn sample(&self, rng: &mut impl Rng) -> f64 {
+        self.quantile(rng.random::<f64>())
+    }
+}
+
+/// Exact inverse-CDF sampler of a [`TabulatedPdf2d`]: `x` from the marginal
+/// CDF over columns, then `y` from the conditional CDF of that column, each
+/// uniform within its cell. Exact for the tabulated (piecewise-constant)
+/// density; tabulate a [`BicubicPdf`] finely ([`BicubicPdf::tabulate`]) to
+/// sample it to any accuracy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InverseCdfSampler2d {
+    x: BinAxis,
+    y: BinAxis,
+    marginal: GuidedCdf,
+    /// One conditional CDF per column; `None` for columns without mass.
+    conditionals: Vec<Option<GuidedCdf>>,
+}
+
+impl InverseCdfSampler2d {
+    /// Precomputes the marginal and conditional CDFs (O(cells)).
+    pub fn new(pdf: &TabulatedPdf2d) -> Self {
+        let ny = pdf.y.bins;
+        let mut marginal = Vec::with_capacity(pdf.x.bins);
+        let mut conditionals = Vec::with_capacity(pdf.x.bins);
+        for col in pdf.density.chunks_exact(ny) {
+            let m: f64 = col.iter().sum();
+            marginal.push(m);
+            conditionals.push((m > 0.0).then(|| GuidedCdf::new(col)));
+        }
+        Self {
+            x: pdf.x,
+            y: pdf.y,
+            marginal: GuidedCdf::new(&marginal),
+            conditionals,
+        }
+    }
+
+    fn y_in_column(&self, cdf: &GuidedCdf, u: f64) -> f64 {
+        let (j, f) = cdf.locate(u);
+        (self.y.edge(j) + f * self.y.width()).min(self.y.max)
+    }
+
+    /// One joint draw `(x, y)`.
+    #[inline]
+    pub fn sample(&self, rng: &mut impl Rng) -> (f64, f64) {
+        let (i, f) = self.marginal.locate(rng.random::<f64>());
+        let x = (self.x.edge(i) + f * self.x.width()).min(self.x.max);
+        // Columns picked by the marginal always have mass.
+        let y = match &self.conditionals[i] {
+            Some(c) => self.y_in_column(c, rng.random::<f64>()),
+            None => self.y.center(0),
+        };
+        (x, y)
+    }
+
+    /// One draw of `x` from its marginal.
+    pub fn sample_x(&self, rng: &mut impl Rng) -> f64 {
+        let (i, f) = self.marginal.locate(rng.random::<f64>());
+        (self.x.edge(i) + f * self.x.width()).min(self.x.max)
+    }
+
+    /// One draw of `y` conditional on `x` (the column holding `x`), as the
+    /// cloner's quality control needs (Medina 2018, §2.4).
+    ///
+    /// # Errors
+    /// [`Error::OutsideSupport`] if `x` is outside the table,
+    /// [`Error::ZeroMass`] if its column has no mass.
+    pub fn sample_y_given_x(&self, x: f64, rng: &mut impl Rng) -> Result<f64> {
+        let i = self.x.bin_of(x).ok_or(Error::OutsideSupport {
+            value: x,
+            min: self.x.min,
+            max: self.x.max,
+        })?;
+        match &self.conditionals[i] {
+            Some(c) => Ok(self.y_in_column(c, rng.random::<f64>())),
+            None => Err(Error::ZeroMass {
+                context: format!("in the column holding x = {x}"),
+            }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn guided_cdf_locates_every_cell_and_skips_empty_ones() {
+        let c = GuidedCdf::new(&[0.0, 1.0, 0.0, 0.0, 3.0, 0.0]);
+        assert_eq!(c.locate(0.0).0, 1);
+        assert_eq!(c.locate(0.2499).0, 1);
+        assert_eq!(c.locate(0.25).0, 4);
+        let (k, f) = c.locate(0.625);
+        assert_eq!(k, 4);
+        assert_relative_eq!(f, 0.5);
+        assert_eq!(c.locate(1.0 - 1e-16).0, 4);
+    }
+
+    #[test]
+    fn inverse_cdf_1d_quantiles_are_exact() {
+        let axis = BinAxis::new(0.0, 4.0, 4).expect("ok");
+        let s = InverseCdfSampler1d::new(axis, &[1.0, 0.0, 2.0, 1.0]).expect("ok");
+        assert_relative_eq!(s.quantile(0.0), 0.0);
+        assert_relative_eq!(s.quantile(0.125), 0.5);
+        // Mass 1/4 in [0, 1), 0 in [1, 2), 1/2 in [2, 3): u = 0.5 → 2.5.
+        assert_relative_eq!(s.quantile(0.5), 2.5);
+        assert_relative_eq!(s.quantile(0.875), 3.5);
+        assert!(s.quantile(1.0) <= 4.0);
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for _ in 0..1000 {
+            let v = s.sample(&mut rng);
+            assert!((0.0..=4.0).contains(&v) && !(1.0..2.0).contains(&v));
+        }
+        assert!(matches!(
+            InverseCdfSampler1d::new(axis, &[0.0; 4]),
+            Err(Error::ZeroMass { .. })
+        ));
+        assert!(matches!(
+            InverseCdfSampler1d::new(axis, &[1.0; 3]),
+            Err(Error::RaggedTable { .. })
+        ));
+        assert!(matches!(
+            InverseCdfSampler1d::new(axis, &[1.0, f64::NAN, 1.0, 1.0]),
+            Err(Error::NonPositive { index: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn conditional_sampling_respects_columns() {
+        let x = BinAxis::new(0.0, 2.0, 2).expect("ok");
+        let y = BinAxis::new(0.0, 2.0, 2).expect("ok");
+        // Column 0: all mass in y ∈ [1, 2); column 1: no mass.
+        let t = TabulatedPdf2d::new(x, y, vec![0.0, 1.0, 0.0, 0.0]).expect("ok");
+        let s = InverseCdfSampler2d::new(&t);
+        let seed = 7;
+        #[expect(clippy::print_stdout, reason = "seeded tests print their seed")]
+        {
+            println!("seed {seed}");
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        for _ in 0..200 {
+            let (a, b) = s.sample(&mut rng);
+            assert!((0.0..1.0).contains(&a) && (1.0..=2.0).contains(&b));
+            let c = s
+                .sample_y_given_x(0.3, &mut rng)
+                .expect("column 0 has mass");
+            assert!((1.0..=2.0).contains(&c));
+        }
+        assert!(matches!(
+            s.sample_y_given_x(1.5, &mut rng),
+            Err(Error::ZeroMass { .. })
+        ));
+        assert!(matches!(
+            s.sample_y_given_x(2.5, &mut rng),
+            Err(Error::OutsideSupport { .. })
+        ));
+        let ar = AcceptanceRejection2d::new(t).expect("ok");
+        assert_relative_eq!(ar.expected_trials(), 4.0);
+        for _ in 0..200 {
+            let (a, b) = ar.sample(&mut rng);
+            assert!((0.0..1.0).contains(&a) && (1.0..=2.0).contains(&b));
+        }
+    }
+}
