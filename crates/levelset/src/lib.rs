@@ -1,12 +1,22 @@
 //! Signed-distance (level-set) grids of grains — the grain representation of
 //! LS-DEM (Kawamoto et al. 2016) and of GSC 2.0 (Medina 2018).
 //!
-//! This crate will hold (issue 3): a uniform grid of signed distances
-//! (negative inside, x fastest in memory) with a rigid pose; construction from
-//! analytic shapes, star-shaped radius functions, closed triangle meshes and
-//! binary voxel images; reinitialisation to a true distance field; trilinear
-//! value/gradient queries; LS-DEM node-to-grid contact; volume, area, inertia
-//! and principal axes; marching-cubes surfaces; and LS-DEM, LAMMPS-LSDEM, VTK
-//! and STL readers/writers over `BufRead`/`Write`.
-//!
 //! Layer 0: no internal dependencies (see `docs/architecture.md`).
+
+pub mod contact;
+pub mod error;
+pub mod grid;
+pub mod mesh;
+pub mod properties;
+pub mod reinit;
+pub mod shapes;
+pub mod star;
+pub mod surface;
+
+pub use contact::{Body, NodeContact, contact, contact_into};
+pub use error::{Error, Result};
+pub use grid::{Grid, GridSpec};
+pub use mesh::{MeshDistance, TriMesh};
+pub use properties::{MassProperties, Principal};
+pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
+pub use star::{DirectionTable, StarBuild, StarParams};

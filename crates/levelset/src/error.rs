@@ -1,0 +1,145 @@
+//! The one error type of the crate.
+
+/// Everything that can go wrong in `levelset`; every variant carries the offending values.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Grid spacing must be finite and strictly positive.
+    #[error("grid spacing must be finite and positive, got {spacing}")]
+    NonPositiveSpacing {
+        /// The spacing given.
+        spacing: f64,
+    },
+    /// Every axis needs at least two cells (three nodes).
+    #[error("axis {axis} has {nodes} nodes; at least 3 (2 cells) are required")]
+    TooFewNodes {
+        /// Axis index (0 = x, 1 = y, 2 = z).
+        axis: usize,
+        /// Number of nodes given on that axis.
+        nodes: usize,
+    },
+    /// The grid would exceed the addressable size.
+    #[error("grid of {dims:?} nodes is too large")]
+    GridTooLarge {
+        /// Requested dimensions.
+        dims: [usize; 3],
+    },
+    /// The number of values does not match the dimensions.
+    #[error("expected {expected} values for the grid, got {found}")]
+    ValueCountMismatch {
+        /// nx·ny·nz.
+        expected: usize,
+        /// Number given.
+        found: usize,
+    },
+    /// A grid value (or produced value) is NaN or infinite.
+    #[error("value {value} at index {index} is not finite")]
+    NonFiniteValue {
+        /// Linear index (x fastest).
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A geometric parameter is out of its domain.
+    #[error("parameter {name} = {value} is invalid: {requirement}")]
+    InvalidParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// Value given.
+        value: f64,
+        /// What is required.
+        requirement: &'static str,
+    },
+    /// A radius function returned a non-finite or non-positive radius.
+    #[error(
+        "radius function returned {value} in direction ({x}, {y}, {z}); radii must be finite and positive"
+    )]
+    InvalidRadius {
+        /// Returned value.
+        value: f64,
+        /// Direction x component.
+        x: f64,
+        /// Direction y component.
+        y: f64,
+        /// Direction z component.
+        z: f64,
+    },
+    /// The grid has no zero crossing, so there is no surface to work on.
+    #[error("the grid has no zero level set (no sign change between neighbouring nodes)")]
+    NoSurface,
+    /// A mesh is empty.
+    #[error("mesh has no triangles")]
+    EmptyMesh,
+    /// A triangle refers to a vertex that does not exist.
+    #[error("triangle {triangle} refers to vertex {index} but the mesh has {vertices} vertices")]
+    VertexIndexOutOfRange {
+        /// Triangle index.
+        triangle: usize,
+        /// Offending vertex index.
+        index: usize,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A triangle has zero area or repeats a vertex.
+    #[error("triangle {triangle} is degenerate (repeated vertex or zero area)")]
+    DegenerateTriangle {
+        /// Triangle index.
+        triangle: usize,
+    },
+    /// The mesh is not closed and consistently oriented.
+    #[error(
+        "mesh is not closed: edge ({a}, {b}) is used {count} times in this direction and {reverse} times reversed"
+    )]
+    NonClosedMesh {
+        /// First vertex of the edge.
+        a: usize,
+        /// Second vertex of the edge.
+        b: usize,
+        /// Number of triangles using a→b.
+        count: usize,
+        /// Number of triangles using b→a.
+        reverse: usize,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("vertex {index} has a non-finite coordinate")]
+    NonFiniteVertex {
+        /// Vertex index.
+        index: usize,
+    },
+    /// More surface nodes were requested than the surface can provide.
+    #[error(
+        "requested {requested} surface nodes but only {available} candidates exist at this resolution"
+    )]
+    TooManyNodes {
+        /// Requested count.
+        requested: usize,
+        /// Candidate count.
+        available: usize,
+    },
+    /// A voxel image does not match its stated dimensions.
+    #[error("image has {found} voxels but dimensions {dims:?} need {expected}")]
+    ImageSizeMismatch {
+        /// Stated dimensions.
+        dims: [usize; 3],
+        /// Required number of voxels.
+        expected: usize,
+        /// Number given.
+        found: usize,
+    },
+    /// A file could not be parsed.
+    #[error("{format} parse error at line {line}: {reason}")]
+    Parse {
+        /// Format name (`"morph"`, `"lammps"`, `"vtk"`, `"stl"`).
+        format: &'static str,
+        /// 1-based line number (0 for binary data: see `reason`).
+        line: usize,
+        /// What was wrong.
+        reason: String,
+    },
+    /// Reading or writing failed.
+    #[error("i/o error: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// Result alias of the crate.
+pub type Result<T> = std::result::Result<T, Error>;
