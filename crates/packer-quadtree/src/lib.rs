@@ -35,6 +35,7 @@ mod domain;
 mod error;
 mod grading;
 mod index;
+mod io;
 mod metrics;
 mod packer;
 
@@ -42,6 +43,7 @@ pub use domain::Domain;
 pub use error::{Error, Result};
 pub use grading::{Grading, MixtureComponent, estimate_count};
 pub use index::{CellGrid, MxQuadtree, SpatialIndex};
+pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};
 pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };

@@ -29,7 +29,13 @@
 //!   touching two walls (or the bottom of a circular domain);
 //! * "top of the list" for new particles ([`FrontOrder::Stack`], the seed's
 //!   text) or a list kept sorted lowest-then-leftmost
-//!   ([`FrontOrder::LowestFirst`]);
+//!   ([`FrontOrder::LowestFirst`]); the default [`FrontOrder::Best`] runs
+//!   both and keeps the denser packing (stack wins in wide domains, sorted
+//!   in narrow slots);
+//! * the seed's "at least two good intersections" rule: with exactly one,
+//!   the particle is still placed there and the front is removed;
+//! * ties of ordinate are broken by the smaller abscissa (the seed's
+//!   front-list criterion reused).
 //! * feasibility tolerance: a candidate may enter a halo by `1e-10 · d_max`
 //!   (round-off of the intersection), far below the `1e-9 · d` overlap
 //!   criterion of the checker.
@@ -82,6 +88,15 @@ pub enum FrontOrder {
     Stack,
     /// The list is kept sorted lowest-then-leftmost at all times.
     LowestFirst,
+    /// Beyond the seed: fronts are ordered by their own best candidate, so
+    /// every particle goes to the lowest feasible position over the whole
+    /// front (a geometric gravity deposition); keys are refreshed lazily.
+    LowestCandidate,
+    /// Beyond the seed: run [`FrontOrder::Stack`] and
+    /// [`FrontOrder::LowestFirst`] on the same sizes and keep the denser
+    /// packing (the stack order builds tight rows in wide domains, the
+    /// sorted order avoids wall-climbing chains in narrow slots).
+    Best,
 }
 
 /// Packer parameters (plain data with `Default`, validated at entry).
@@ -103,7 +118,7 @@ impl Default for PackParams {
         Self {
             boundary: BoundaryMode::Exact,
             halo: HaloMode::ParticleDiameter,
-            front_order: FrontOrder::Stack,
+            front_order: FrontOrder::Best,
             max_particles: 100_000_000,
         }
     }
@@ -260,6 +275,28 @@ pub fn pack_sizes_with_index<I: SpatialIndex>(
             particle: dmax,
         });
     }
+    if params.front_order == FrontOrder::Best {
+        let a = pack_sizes_with_index::<I>(
+            domain,
+            sizes,
+            d_max,
+            &PackParams {
+                front_order: FrontOrder::Stack,
+                ..*params
+            },
+        )?;
+        let b = pack_sizes_with_index::<I>(
+            domain,
+            sizes,
+            d_max,
+            &PackParams {
+                front_order: FrontOrder::LowestFirst,
+                ..*params
+            },
+        )?;
+        let solid = |p: &Packing| p.disks.iter().map(|d| d.radius * d.radius).sum::<f64>();
+        return Ok(if solid(&b) > solid(&a) { b } else { a });
+    }
     let mut p = Packer::<I>::new(shape, sizes, dmax, d_min, params);
     p.run()?;
     let n_b = p.n_boundary;
@@ -414,6 +451,9 @@ impl Ord for Key {
 enum Fronts {
     Stack(Vec<u32>),
     Heap(BinaryHeap<Key>),
+    /// Placeholder of the candidate-keyed order; its heap lives in
+    /// `run_candidates`, the initial fronts are all disks present.
+    Candidates(()),
 }
 
 impl Fronts {
@@ -421,6 +461,7 @@ impl Fronts {
         match self {
             Self::Stack(v) => v.last().copied(),
             Self::Heap(h) => h.peek().map(|k| k.id),
+            Self::Candidates(()) => None,
         }
     }
     fn pop(&mut self) {
@@ -431,6 +472,7 @@ impl Fronts {
             Self::Heap(h) => {
                 h.pop();
             }
+            Self::Candidates(()) => {}
         }
     }
     fn push(&mut self, id: u32, q: &[f64; 3]) {
@@ -441,6 +483,7 @@ impl Fronts {
                 x: q[0],
                 id,
             }),
+            Self::Candidates(()) => {}
         }
     }
 }
@@ -544,6 +587,9 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
         });
         let fronts = match params.front_order {
             FrontOrder::Stack => Fronts::Stack(order.into_iter().rev().collect()),
+            FrontOrder::LowestCandidate => Fronts::Candidates(()),
+            // Resolved by `pack_sizes_with_index` before a packer is built.
+            FrontOrder::Best => Fronts::Stack(order.into_iter().rev().collect()),
             FrontOrder::LowestFirst => Fronts::Heap(
                 order
                     .iter()
@@ -670,75 +716,92 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
         }
     }
 
+    /// Evaluates front `fi` for a particle of radius `r`: the number of
+    /// feasible candidates (counted up to two) and the lowest-then-leftmost
+    /// feasible one.
+    fn evaluate(&mut self, fi: u32, r: f64, scratch: &mut Scratch) -> (u32, Option<[f64; 2]>) {
+        self.stats.front_visits += 1;
+        let rh = self.halo_offset(r);
+        let f = self.xs[fi as usize];
+        let cf = [f[0], f[1]];
+        let rho = f[2] + rh;
+        let reach = f[2] + self.r_max + 2.0 * rh + self.tol;
+        let Scratch { ids, nb, cand } = scratch;
+        ids.clear();
+        self.index.query(
+            Point2::new(cf[0] - reach, cf[1] - reach),
+            Point2::new(cf[0] + reach, cf[1] + reach),
+            ids,
+        );
+        nb.clear();
+        cand.clear();
+        for &id in ids.iter() {
+            if id == fi {
+                continue;
+            }
+            let o = self.xs[id as usize];
+            let (dx, dy) = (o[0] - cf[0], o[1] - cf[1]);
+            let big = o[2] + rh;
+            let s = rho + big;
+            if dx * dx + dy * dy <= s * s {
+                nb.push([o[0], o[1], big]);
+                circle_circle(cf, rho, [o[0], o[1]], big, cand);
+            }
+        }
+        if self.exact
+            && let Some(kc) = self.wall_grid.cell(cf)
+        {
+            for &wi in self.wall_grid.near(kc) {
+                circle_wall(cf, rho, &self.walls[wi as usize], rh, cand);
+            }
+        }
+        // Track the lowest and second-lowest feasible candidates (order:
+        // ordinate, then abscissa); a candidate not below the current second
+        // cannot change the outcome and is not tested.
+        let below = |c: &[f64; 2], o: &[f64; 2]| c[1] < o[1] || (c[1] == o[1] && c[0] < o[0]);
+        let mut best: Option<[f64; 2]> = None;
+        let mut second: Option<[f64; 2]> = None;
+        for &p in cand.iter() {
+            if let Some(s2) = &second
+                && !below(&p, s2)
+            {
+                continue;
+            }
+            let clear = nb.iter().all(|o| {
+                let (dx, dy) = (p[0] - o[0], p[1] - o[1]);
+                let m = o[2] - self.tol;
+                dx * dx + dy * dy >= m * m
+            });
+            if clear && self.in_domain(p, rh) {
+                match &best {
+                    Some(b1) if !below(&p, b1) => second = Some(p),
+                    _ => {
+                        second = best;
+                        best = Some(p);
+                    }
+                }
+            }
+        }
+        let good = u32::from(best.is_some()) + u32::from(second.is_some());
+        (good, best)
+    }
+
     fn run(&mut self) -> Result<()> {
         let mut k = 0usize;
         if self.exact {
             self.seed_first()?;
             k = 1;
         }
-        let mut ids: Vec<u32> = Vec::with_capacity(128);
-        let mut nb: Vec<[f64; 3]> = Vec::with_capacity(64);
-        let mut cand: Vec<[f64; 2]> = Vec::with_capacity(128);
+        let mut scratch = Scratch::default();
+        if let Fronts::Candidates(_) = self.fronts {
+            return self.run_candidates(k, &mut scratch);
+        }
         while k < self.sizes.len() {
             let Some(fi) = self.fronts.top() else {
                 break;
             };
-            self.stats.front_visits += 1;
             let r = self.sizes[k] * 0.5;
-            let rh = self.halo_offset(r);
-            let f = self.xs[fi as usize];
-            let cf = [f[0], f[1]];
-            let rho = f[2] + rh;
-            let reach = f[2] + self.r_max + 2.0 * rh + self.tol;
-            ids.clear();
-            self.index.query(
-                Point2::new(cf[0] - reach, cf[1] - reach),
-                Point2::new(cf[0] + reach, cf[1] + reach),
-                &mut ids,
-            );
-            nb.clear();
-            cand.clear();
-            for &id in &ids {
-                if id == fi {
-                    continue;
-                }
-                let o = self.xs[id as usize];
-                let (dx, dy) = (o[0] - cf[0], o[1] - cf[1]);
-                let big = o[2] + rh;
-                let s = rho + big;
-                if dx * dx + dy * dy <= s * s {
-                    nb.push([o[0], o[1], big]);
-                    circle_circle(cf, rho, [o[0], o[1]], big, &mut cand);
-                }
-            }
-            if self.exact
-                && let Some(kc) = self.wall_grid.cell(cf)
-            {
-                {
-                    for &wi in self.wall_grid.near(kc) {
-                        circle_wall(cf, rho, &self.walls[wi as usize], rh, &mut cand);
-                    }
-                }
-            }
-            cand.sort_unstable_by(|a, b| a[1].total_cmp(&b[1]).then(a[0].total_cmp(&b[0])));
-            let mut best: Option<[f64; 2]> = None;
-            let mut good = 0;
-            for &p in &cand {
-                let clear = nb.iter().all(|o| {
-                    let (dx, dy) = (p[0] - o[0], p[1] - o[1]);
-                    let m = o[2] - self.tol;
-                    dx * dx + dy * dy >= m * m
-                });
-                if clear && self.in_domain(p, rh) {
-                    good += 1;
-                    if best.is_none() {
-                        best = Some(p);
-                    }
-                    if good >= 2 {
-                        break;
-                    }
-                }
-            }
+            let (good, best) = self.evaluate(fi, r, &mut scratch);
             match best {
                 None => {
                     self.fronts.pop();
@@ -756,4 +819,79 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
         }
         Ok(())
     }
+
+    /// [`FrontOrder::LowestCandidate`]: a heap of fronts keyed by their best
+    /// candidate, re-evaluated lazily when popped.
+    fn run_candidates(&mut self, mut k: usize, scratch: &mut Scratch) -> Result<()> {
+        let mut heap = BinaryHeap::new();
+        if k < self.sizes.len() {
+            let r = self.sizes[k] * 0.5;
+            for fi in 0..self.xs.len() as u32 {
+                if let (_, Some(p)) = self.evaluate(fi, r, scratch) {
+                    heap.push(Key {
+                        y: p[1],
+                        x: p[0],
+                        id: fi,
+                    });
+                }
+            }
+        }
+        while k < self.sizes.len() {
+            let Some(top) = heap.pop() else {
+                break;
+            };
+            let r = self.sizes[k] * 0.5;
+            let (good, best) = self.evaluate(top.id, r, scratch);
+            let Some(p) = best else {
+                self.stats.fronts_removed += 1;
+                continue;
+            };
+            // Stale key: if the fresh candidate is no longer the lowest,
+            // put the front back with its fresh key.
+            if let Some(next) = heap.peek()
+                && (p[1], p[0]) > (next.y, next.x)
+            {
+                heap.push(Key {
+                    y: p[1],
+                    x: p[0],
+                    id: top.id,
+                });
+                continue;
+            }
+            let q = [p[0], p[1], r];
+            let id = self.xs.len() as u32;
+            self.xs.push(q);
+            self.index.insert(id, Point2::new(p[0], p[1]));
+            k += 1;
+            if good >= 2 {
+                // Keys only grow for a fixed size: the old key is a valid
+                // lower bound until the front is popped again.
+                heap.push(Key {
+                    y: p[1],
+                    x: p[0],
+                    id: top.id,
+                });
+            } else {
+                self.stats.fronts_removed += 1;
+            }
+            if k < self.sizes.len() {
+                let rn = self.sizes[k] * 0.5;
+                if let (_, Some(pn)) = self.evaluate(id, rn, scratch) {
+                    heap.push(Key {
+                        y: pn[1],
+                        x: pn[0],
+                        id,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[derive(Default)]
+struct Scratch {
+    ids: Vec<u32>,
+    nb: Vec<[f64; 3]>,
+    cand: Vec<[f64; 2]>,
 }
