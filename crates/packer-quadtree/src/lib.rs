@@ -33,6 +33,7 @@
 
 mod domain;
 mod error;
+mod ga;
 mod grading;
 mod index;
 mod io;
@@ -41,6 +42,7 @@ mod packer;
 
 pub use domain::Domain;
 pub use error::{Error, Result};
+pub use ga::{GaParams, GaResult, graded_layers, optimise_porosity};
 pub use grading::{Grading, MixtureComponent, estimate_count};
 pub use index::{CellGrid, MxQuadtree, SpatialIndex};
 pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};
