@@ -16,7 +16,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-const SEED: u64 = 0x6573_6332_3031_38;
+const SEED: u64 = 0x0065_7363_3230_3138;
 const MX: f64 = 1.0;
 const SX: f64 = 0.5;
 const MY: f64 = 2.0;
