@@ -3,9 +3,10 @@
 //!
 //! Build: (1) the radius function is tabulated on a cube map (six gnomonic faces of
 //! `(n+1)²` directions, default n = 32 → 6534 calls, independent of the grid size) or, with
-//! [`DirectionTable::Exact`], called once per node; (2) every node gets the radial signed
-//! distance `|x − c| − r(û)`; its magnitude is an upper bound of the true distance (the
-//! surface point on the ray is at that distance); (3) fast-sweeping reinitialisation
+//! [`DirectionTable::Exact`], called once per node; (2) every node in the shell
+//! `r_min − 2h ≤ |x − c| ≤ r_max + 2h` gets the radial signed distance `|x − c| − r(û)`, whose
+//! magnitude is an upper bound of the true distance (the surface point on the ray is at that
+//! distance); nodes inside or outside the shell only get their sign; (3) fast-sweeping reinitialisation
 //! seeded with those upper bounds ([`crate::reinit`]). Design choice: a cube map instead of
 //! a (θ, φ) table needs no trigonometry per node and has no pole singularity.
 
@@ -60,6 +61,9 @@ impl StarParams {
         Ok(())
     }
 }
+
+/// Magnitude standing for "far from the interface, distance unknown" before sweeping.
+const FAR: f64 = 1e300;
 
 /// Diagnostics of a star build.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -174,16 +178,28 @@ impl Grid {
             DirectionTable::CubeMap { face_cells } => {
                 let map = CubeMap::build(face_cells, &mut radius)?;
                 calls = map.radii.len();
-                let centre_radius = map.radius(&Vector3::z());
+                // Narrow shell: interpolated radii lie in [r_min, r_max], so nodes with
+                // ρ < r_min − 2h are inside and nodes with ρ > r_max + 2h outside, and
+                // neither touches the interface; they start at ∓∞ (far marker) and get
+                // their distance from the sweeps. Only the shell is looked up.
+                let (rmin, rmax) = map
+                    .radii
+                    .iter()
+                    .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+                let inner = (rmin - 2.0 * h).max(0.0);
+                let inner2 = inner * inner;
+                let outer2 = (rmax + 2.0 * h) * (rmax + 2.0 * h);
                 for k in 0..nz {
                     for j in 0..ny {
                         for i in 0..nx {
                             let d = spec.node(i, j, k) - centre;
-                            let rho = d.norm();
-                            values.push(if rho > 1e-12 * h {
-                                rho - map.radius(&d)
+                            let rho2 = d.norm_squared();
+                            values.push(if rho2 < inner2 {
+                                -FAR
+                            } else if rho2 > outer2 {
+                                FAR
                             } else {
-                                -centre_radius
+                                rho2.sqrt() - map.radius(&d)
                             });
                         }
                     }
