@@ -6,6 +6,7 @@
 pub mod contact;
 pub mod error;
 pub mod grid;
+pub mod io;
 pub mod mesh;
 pub mod properties;
 pub mod reinit;
