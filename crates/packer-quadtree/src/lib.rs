@@ -50,6 +50,6 @@ pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };
 pub use packer::{
-    BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_sizes,
-    pack_sizes_with_index, pack_with_index,
+    BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,
+    pack_sizes, pack_sizes_with_index, pack_with_index,
 };

@@ -30,8 +30,8 @@
 //! * "top of the list" for new particles ([`FrontOrder::Stack`], the seed's
 //!   text) or a list kept sorted lowest-then-leftmost
 //!   ([`FrontOrder::LowestFirst`]); the default [`FrontOrder::Best`] runs
-//!   both and keeps the denser packing (stack wins in wide domains, sorted
-//!   in narrow slots);
+//!   both and keeps the denser packing (stack wins in wide domains, sorted in
+//!   narrow slots);
 //! * the seed's "at least two good intersections" rule: with exactly one,
 //!   the particle is still placed there and the front is removed;
 //! * ties of ordinate are broken by the smaller abscissa (the seed's
@@ -94,8 +94,8 @@ pub enum FrontOrder {
     LowestCandidate,
     /// Beyond the seed: run [`FrontOrder::Stack`] and
     /// [`FrontOrder::LowestFirst`] on the same sizes and keep the denser
-    /// packing (the stack order builds tight rows in wide domains, the
-    /// sorted order avoids wall-climbing chains in narrow slots).
+    /// packing (the stack order builds tight rows in wide domains,
+    /// the sorted order avoids wall-climbing chains in narrow slots).
     Best,
 }
 
@@ -204,6 +204,26 @@ pub fn pack(
     pack_with_index::<CellGrid>(domain, grading, params, rng)
 }
 
+/// [`pack`] with a ChaCha8 generator seeded by `seed` (convenience for
+/// callers without their own RNG, e.g. the `validate` cases).
+///
+/// # Errors
+/// As [`pack`].
+pub fn pack_seeded(
+    domain: &Domain,
+    grading: &Grading,
+    params: &PackParams,
+    seed: u64,
+) -> Result<Packing> {
+    use rand::SeedableRng;
+    pack(
+        domain,
+        grading,
+        params,
+        &mut rand_chacha::ChaCha8Rng::seed_from_u64(seed),
+    )
+}
+
 /// [`pack`] with a chosen spatial index (e.g. [`crate::MxQuadtree`]).
 ///
 /// # Errors
@@ -276,26 +296,21 @@ pub fn pack_sizes_with_index<I: SpatialIndex>(
         });
     }
     if params.front_order == FrontOrder::Best {
-        let a = pack_sizes_with_index::<I>(
-            domain,
-            sizes,
-            d_max,
-            &PackParams {
-                front_order: FrontOrder::Stack,
+        let mut best: Option<(f64, Packing)> = None;
+        for order in [FrontOrder::Stack, FrontOrder::LowestFirst] {
+            let sub = PackParams {
+                front_order: order,
                 ..*params
-            },
-        )?;
-        let b = pack_sizes_with_index::<I>(
-            domain,
-            sizes,
-            d_max,
-            &PackParams {
-                front_order: FrontOrder::LowestFirst,
-                ..*params
-            },
-        )?;
-        let solid = |p: &Packing| p.disks.iter().map(|d| d.radius * d.radius).sum::<f64>();
-        return Ok(if solid(&b) > solid(&a) { b } else { a });
+            };
+            let p = pack_sizes_with_index::<I>(domain, sizes, d_max, &sub)?;
+            let solid = p.disks.iter().map(|d| d.radius * d.radius).sum::<f64>();
+            if best.as_ref().is_none_or(|(s, _)| solid > *s) {
+                best = Some((solid, p));
+            }
+        }
+        return best.map(|(_, p)| p).ok_or(Error::Empty {
+            what: "front order list",
+        });
     }
     let mut p = Packer::<I>::new(shape, sizes, dmax, d_min, params);
     p.run()?;
