@@ -13,6 +13,7 @@ pub mod reinit;
 pub mod shapes;
 pub mod star;
 pub mod surface;
+pub mod voxel;
 
 pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};
