@@ -7,8 +7,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use morph_dna::{
-    AcceptanceRejection2d, Bandwidth, BicubicPdf, Descriptor, DnaTable, GaussianCopula,
-    GaussianKde2d, Histogram2d, InverseCdfSampler2d,
+    AcceptanceRejection2d, Bandwidth, BicubicPdf, Descriptor, DnaTable, EnvelopeRejection2d,
+    GaussianCopula, GaussianKde2d, Histogram2d, InverseCdfSampler2d,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -34,6 +34,7 @@ fn samplers(c: &mut Criterion) {
     let pdf = BicubicPdf::from_histogram(&hist, 8).expect("valid pdf");
     let table = pdf.tabulate(8).expect("valid table");
     let inverse = InverseCdfSampler2d::new(&table);
+    let env = EnvelopeRejection2d::new(pdf.clone()).expect("bounded pdf");
     let ar = AcceptanceRejection2d::new(pdf).expect("bounded pdf");
     let kde = GaussianKde2d::fit(&xs, &ys, Bandwidth::Scott).expect("valid kde");
     let dna = DnaTable::from_columns(
@@ -71,6 +72,16 @@ fn samplers(c: &mut Criterion) {
             let mut acc = 0.0;
             for _ in 0..BATCH {
                 let (x, y) = ar.sample(&mut rng);
+                acc += x + y;
+            }
+            black_box(acc)
+        });
+    });
+    g.bench_function("envelope_rejection_bicubic", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for _ in 0..BATCH {
+                let (x, y) = env.sample(&mut rng);
                 acc += x + y;
             }
             black_box(acc)

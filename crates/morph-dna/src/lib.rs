@@ -12,6 +12,7 @@
 //! * [`Histogram1d`], [`Histogram2d`]; densities [`BicubicPdf`] (the seed's
 //!   choice), [`GaussianKde2d`] (smoother alternative), [`TabulatedPdf2d`].
 //! * Samplers: [`AcceptanceRejection2d`] (the seed's Monte Carlo),
+//!   [`EnvelopeRejection2d`] (the same target with a per-bin envelope),
 //!   [`InverseCdfSampler1d`] / [`InverseCdfSampler2d`] (exact tabulated
 //!   inverse CDF with conditional draws), [`GaussianCopula`] (joint model of
 //!   all descriptors).
@@ -102,5 +103,7 @@ pub use radial::{
     NeighbourCorrelation, RadialProfiles, SphericalMesh, all_neighbour_correlations,
     neighbour_correlation,
 };
-pub use sampling::{AcceptanceRejection2d, Density2d, InverseCdfSampler1d, InverseCdfSampler2d};
+pub use sampling::{
+    AcceptanceRejection2d, Density2d, EnvelopeRejection2d, InverseCdfSampler1d, InverseCdfSampler2d,
+};
 pub use table::{Descriptor, DnaTable};

@@ -210,6 +210,32 @@ impl BicubicPdf {
         CATMULL_ROM_ABS_SUM * CATMULL_ROM_ABS_SUM * self.max_node * self.scale
     }
 
+    /// Rigorous upper bound of the density on each histogram bin, in the
+    /// layout of [`Histogram2d::counts`]: `(5/4)² · scale ·` the largest node
+    /// of the 5 × 5 block the bin's interpolation stencils can reach.
+    pub fn cell_upper_bounds(&self) -> Vec<f64> {
+        let (nx, ny) = (self.x.bins, self.y.bins);
+        // Running maxima over ±2 nodes, first along y then along x.
+        let mut along_y = vec![0.0f64; nx * ny];
+        for i in 0..nx {
+            for j in 0..ny {
+                let (lo, hi) = (j.saturating_sub(2), (j + 2).min(ny - 1));
+                along_y[i * ny + j] =
+                    (lo..=hi).fold(0.0, |m: f64, q| m.max(self.nodes[i * ny + q]));
+            }
+        }
+        let factor = CATMULL_ROM_ABS_SUM * CATMULL_ROM_ABS_SUM * self.scale;
+        let mut out = vec![0.0; nx * ny];
+        for i in 0..nx {
+            let (lo, hi) = (i.saturating_sub(2), (i + 2).min(nx - 1));
+            for j in 0..ny {
+                out[i * ny + j] =
+                    factor * (lo..=hi).fold(0.0, |m: f64, p| m.max(along_y[p * ny + j]));
+            }
+        }
+        out
+    }
+
     /// Tabulates the density at the centres of `refine × refine` sub-cells
     /// per histogram bin, for the exact inverse-CDF sampler.
     ///
@@ -460,6 +486,28 @@ mod tests {
         assert_relative_eq!(p.density(4.5, 0.5), 0.0);
         // At x = 3.5 the raw interpolant is −0.0625 · 0.1 < 0: clamped.
         assert_relative_eq!(p.density(3.5, 0.5), 0.0);
+    }
+
+    #[test]
+    fn cell_bounds_dominate_the_density() {
+        let xs = [0.5, 1.5, 1.5, 1.5, 2.5, 2.5, 4.5, 0.2];
+        let ys = [0.5, 0.5, 1.5, 1.7, 0.1, 2.9, 2.5, 2.2];
+        let h = Histogram2d::new(&xs, &ys, (5, 3), Some((0.0, 5.0)), Some((0.0, 3.0))).expect("ok");
+        let p = BicubicPdf::from_histogram(&h, 8).expect("ok");
+        let b = p.cell_upper_bounds();
+        let m = 40;
+        for i in 0..5 {
+            for j in 0..3 {
+                for a in 0..=m {
+                    for c in 0..=m {
+                        let x = i as f64 + a as f64 / m as f64;
+                        let y = j as f64 + c as f64 / m as f64;
+                        assert!(p.density(x, y) <= b[i * 3 + j] * (1.0 + 1e-12));
+                    }
+                }
+                assert!(b[i * 3 + j] <= p.upper_bound());
+            }
+        }
     }
 
     #[test]

@@ -107,6 +107,64 @@ impl<D: Density2d> AcceptanceRejection2d<D> {
     }
 }
 
+/// Acceptance–rejection for a [`BicubicPdf`] under a piecewise-constant
+/// envelope: one rigorous bound per histogram bin
+/// ([`BicubicPdf::cell_upper_bounds`]), a bin drawn in proportion to
+/// `bound · area`, a uniform proposal inside it, acceptance with probability
+/// `f / bound`. Exact like [`AcceptanceRejection2d`] (same target density)
+/// but with far fewer rejections, because the envelope follows the density
+/// instead of its global maximum.
+#[derive(Debug, Clone)]
+pub struct EnvelopeRejection2d {
+    pdf: BicubicPdf,
+    bounds: Vec<f64>,
+    cells: GuidedCdf,
+    expected_trials: f64,
+}
+
+impl EnvelopeRejection2d {
+    /// Builds the envelope (O(bins)).
+    ///
+    /// # Errors
+    /// [`Error::ZeroMass`] if every bound is zero (impossible for a PDF built
+    /// from a non-empty histogram; kept as a guard).
+    pub fn new(pdf: BicubicPdf) -> Result<Self> {
+        let bounds = pdf.cell_upper_bounds();
+        let area = pdf.x_axis().width() * pdf.y_axis().width();
+        let total: f64 = bounds.iter().sum::<f64>() * area;
+        if !(total.is_finite() && total > 0.0) {
+            return Err(Error::ZeroMass {
+                context: "in the envelope".into(),
+            });
+        }
+        Ok(Self {
+            cells: GuidedCdf::new(&bounds),
+            pdf,
+            bounds,
+            expected_trials: total,
+        })
+    }
+
+    /// Expected proposals per accepted draw (the envelope's mass).
+    pub fn expected_trials(&self) -> f64 {
+        self.expected_trials
+    }
+
+    /// One draw.
+    pub fn sample(&self, rng: &mut impl Rng) -> (f64, f64) {
+        let (ax, ay) = (self.pdf.x_axis(), self.pdf.y_axis());
+        loop {
+            let (c, _) = self.cells.locate(rng.random::<f64>());
+            let (i, j) = (c / ay.bins, c % ay.bins);
+            let x = (ax.edge(i) + ax.width() * rng.random::<f64>()).min(ax.max);
+            let y = (ay.edge(j) + ay.width() * rng.random::<f64>()).min(ay.max);
+            if rng.random::<f64>() * self.bounds[c] < self.pdf.density(x, y) {
+                return (x, y);
+            }
+        }
+    }
+}
+
 /// A discrete CDF over `n` cells with a guide table (Chen & Asau 1974) for
 /// O(1) expected lookup.
 #[derive(Debug, Clone, PartialEq)]

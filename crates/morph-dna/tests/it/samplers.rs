@@ -8,9 +8,9 @@
 
 use morph_dna::stats::normal_cdf;
 use morph_dna::{
-    AcceptanceRejection2d, Bandwidth, BicubicPdf, Descriptor, DnaTable, GaussianCopula,
-    GaussianKde2d, Histogram2d, InverseCdfSampler2d, TabulatedPdf2d, ks_distance_to_cdf,
-    stats::pearson,
+    AcceptanceRejection2d, Bandwidth, BicubicPdf, Descriptor, DnaTable, EnvelopeRejection2d,
+    GaussianCopula, GaussianKde2d, Histogram2d, InverseCdfSampler2d, TabulatedPdf2d,
+    ks_distance_to_cdf, stats::pearson,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -72,6 +72,19 @@ fn every_sampler_reproduces_a_correlated_bivariate_normal() {
     let ar = AcceptanceRejection2d::new(bicubic.clone()).expect("bounded");
     let draws: Vec<_> = (0..N_DRAWS).map(|_| ar.sample(&mut rng)).collect();
     check("acceptance-rejection (bicubic)", &draws);
+
+    // Same target, per-bin envelope.
+    let env = EnvelopeRejection2d::new(bicubic.clone()).expect("bounded");
+    let draws: Vec<_> = (0..N_DRAWS).map(|_| env.sample(&mut rng)).collect();
+    check("envelope rejection (bicubic)", &draws);
+    #[expect(clippy::print_stdout, reason = "numbers for the report")]
+    {
+        println!(
+            "expected proposals per draw: global bound {:.2}, per-bin envelope {:.2}",
+            ar.expected_trials(),
+            env.expected_trials()
+        );
+    }
 
     // Exact inverse CDF on the bicubic PDF tabulated 8× finer.
     let inverse = InverseCdfSampler2d::new(&bicubic.tabulate(8).expect("valid table"));
@@ -152,6 +165,7 @@ fn samplers_reproduce_a_density_with_mass_at_the_edges() {
     let bicubic = BicubicPdf::from_histogram(&hist, 8).expect("valid pdf");
     let ar = AcceptanceRejection2d::new(bicubic.clone()).expect("bounded");
     let inverse = InverseCdfSampler2d::new(&bicubic.tabulate(8).expect("valid table"));
+    let env = EnvelopeRejection2d::new(bicubic.clone()).expect("bounded");
     let cdf = |t: f64| 0.5 * (t * t + t);
     // Pearson correlation of f = x + y on the unit square: −1/11.
     let rho = -1.0 / 11.0;
@@ -165,6 +179,10 @@ fn samplers_reproduce_a_density_with_mass_at_the_edges() {
         (
             "inverse CDF (bicubic)",
             (0..N_DRAWS).map(|_| inverse.sample(&mut rng)).collect(),
+        ),
+        (
+            "envelope rejection (bicubic)",
+            (0..N_DRAWS).map(|_| env.sample(&mut rng)).collect(),
         ),
     ] {
         let (x, y): (Vec<f64>, Vec<f64>) = draws.iter().copied().unzip();
