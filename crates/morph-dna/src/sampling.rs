@@ -178,54 +178,72 @@ struct GuidedCdf {
 impl GuidedCdf {
     /// From non-negative weights with positive finite sum.
     fn new(weights: &[f64]) -> Self {
-        let n = weights.len();
-        let total: f64 = weights.iter().sum();
-        let mut cdf = Vec::with_capacity(n + 1);
-        cdf.push(0.0);
-        let mut acc = 0.0;
-        for w in weights {
-            acc += w;
-            cdf.push((acc / total).min(1.0));
-        }
-        // Trailing empty cells keep their exact 1.0; the last positive cell ends at 1.
-        if let Some(last) = weights.iter().rposition(|w| *w > 0.0) {
-            for c in &mut cdf[last + 1..] {
-                *c = 1.0;
-            }
-        }
-        let mut guide = Vec::with_capacity(n);
-        let mut k = 0usize;
-        for g in 0..n {
-            let t = g as f64 / n as f64;
-            while k + 1 < n && cdf[k + 1] <= t {
-                k += 1;
-            }
-            guide.push(k as u32);
-        }
-        Self { cdf, guide }
+        let mut out = Self {
+            cdf: Vec::with_capacity(weights.len() + 1),
+            guide: Vec::with_capacity(weights.len()),
+        };
+        build_guided(weights, &mut out.cdf, &mut out.guide);
+        out
     }
 
     /// Cell `k` with `cdf[k] ≤ u < cdf[k+1]` and the fraction of the way
     /// through it, for `u ∈ [0, 1)`.
     #[inline]
     fn locate(&self, u: f64) -> (usize, f64) {
-        let n = self.guide.len();
-        let g = ((u * n as f64) as usize).min(n - 1);
-        let mut k = self.guide[g] as usize;
-        while k > 0 && self.cdf[k] > u {
-            k -= 1;
+        locate_guided(&self.cdf, &self.guide, u)
+    }
+}
+
+/// Appends the `n + 1` CDF values and `n` guide entries of `weights`
+/// (non-negative, positive finite sum) to `cdf` and `guide`.
+fn build_guided(weights: &[f64], cdf: &mut Vec<f64>, guide: &mut Vec<u32>) {
+    let n = weights.len();
+    let total: f64 = weights.iter().sum();
+    let base = cdf.len();
+    cdf.push(0.0);
+    let mut acc = 0.0;
+    for w in weights {
+        acc += w;
+        cdf.push((acc / total).min(1.0));
+    }
+    // Trailing empty cells keep their exact 1.0; the last positive cell ends at 1.
+    if let Some(last) = weights.iter().rposition(|w| *w > 0.0) {
+        for c in &mut cdf[base + last + 1..] {
+            *c = 1.0;
         }
-        while k + 1 < n && self.cdf[k + 1] <= u {
+    }
+    let cdf = &cdf[base..];
+    let mut k = 0usize;
+    for g in 0..n {
+        let t = g as f64 / n as f64;
+        while k + 1 < n && cdf[k + 1] <= t {
             k += 1;
         }
-        let (lo, hi) = (self.cdf[k], self.cdf[k + 1]);
-        let frac = if hi > lo {
-            ((u - lo) / (hi - lo)).clamp(0.0, 1.0)
-        } else {
-            0.5
-        };
-        (k, frac)
+        guide.push(k as u32);
     }
+}
+
+/// Cell `k` of a guided CDF (`cdf.len() = guide.len() + 1`) with
+/// `cdf[k] ≤ u < cdf[k+1]`, and the fraction of the way through it.
+#[inline]
+fn locate_guided(cdf: &[f64], guide: &[u32], u: f64) -> (usize, f64) {
+    let n = guide.len();
+    let g = ((u * n as f64) as usize).min(n - 1);
+    let mut k = guide[g] as usize;
+    // One step back covers a rounding of `u · n` up across a guide boundary.
+    while k > 0 && cdf[k] > u {
+        k -= 1;
+    }
+    while k + 1 < n && cdf[k + 1] <= u {
+        k += 1;
+    }
+    let (lo, hi) = (cdf[k], cdf[k + 1]);
+    let frac = if hi > lo {
+        ((u - lo) / (hi - lo)).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    (k, frac)
 }
 
 /// Exact inverse-CDF sampler of a piecewise-constant univariate density
@@ -307,45 +325,61 @@ pub struct InverseCdfSampler2d {
     x: BinAxis,
     y: BinAxis,
     marginal: GuidedCdf,
-    /// One conditional CDF per column; `None` for columns without mass.
-    conditionals: Vec<Option<GuidedCdf>>,
+    /// Conditional CDFs of every column, `y.bins + 1` values per column,
+    /// contiguous (columns without mass hold zeros and are never located).
+    cond_cdf: Vec<f64>,
+    /// Guide tables of the conditional CDFs, `y.bins` entries per column.
+    cond_guide: Vec<u32>,
+    /// Whether each column has mass.
+    has_mass: Vec<bool>,
 }
 
 impl InverseCdfSampler2d {
     /// Precomputes the marginal and conditional CDFs (O(cells)).
     pub fn new(pdf: &TabulatedPdf2d) -> Self {
-        let ny = pdf.y.bins;
-        let mut marginal = Vec::with_capacity(pdf.x.bins);
-        let mut conditionals = Vec::with_capacity(pdf.x.bins);
+        let (nx, ny) = (pdf.x.bins, pdf.y.bins);
+        let mut marginal = Vec::with_capacity(nx);
+        let mut cond_cdf = Vec::with_capacity(nx * (ny + 1));
+        let mut cond_guide = Vec::with_capacity(nx * ny);
+        let mut has_mass = Vec::with_capacity(nx);
         for col in pdf.density.chunks_exact(ny) {
             let m: f64 = col.iter().sum();
             marginal.push(m);
-            conditionals.push((m > 0.0).then(|| GuidedCdf::new(col)));
+            has_mass.push(m > 0.0);
+            if m > 0.0 {
+                build_guided(col, &mut cond_cdf, &mut cond_guide);
+            } else {
+                cond_cdf.extend(std::iter::repeat_n(0.0, ny + 1));
+                cond_guide.extend(std::iter::repeat_n(0, ny));
+            }
         }
         Self {
             x: pdf.x,
             y: pdf.y,
             marginal: GuidedCdf::new(&marginal),
-            conditionals,
+            cond_cdf,
+            cond_guide,
+            has_mass,
         }
     }
 
-    fn y_in_column(&self, cdf: &GuidedCdf, u: f64) -> f64 {
-        let (j, f) = cdf.locate(u);
-        (self.y.edge(j) + f * self.y.width()).min(self.y.max)
+    /// `y` drawn from the conditional CDF of column `i` (which has mass).
+    #[inline]
+    fn y_in_column(&self, i: usize, u: f64) -> f64 {
+        let ny = self.y.bins;
+        let cdf = &self.cond_cdf[i * (ny + 1)..(i + 1) * (ny + 1)];
+        let guide = &self.cond_guide[i * ny..(i + 1) * ny];
+        let (j, f) = locate_guided(cdf, guide, u);
+        (self.y.min + (j as f64 + f) * self.y.width()).min(self.y.max)
     }
 
     /// One joint draw `(x, y)`.
     #[inline]
     pub fn sample(&self, rng: &mut impl Rng) -> (f64, f64) {
         let (i, f) = self.marginal.locate(rng.random::<f64>());
-        let x = (self.x.edge(i) + f * self.x.width()).min(self.x.max);
+        let x = (self.x.min + (i as f64 + f) * self.x.width()).min(self.x.max);
         // Columns picked by the marginal always have mass.
-        let y = match &self.conditionals[i] {
-            Some(c) => self.y_in_column(c, rng.random::<f64>()),
-            None => self.y.center(0),
-        };
-        (x, y)
+        (x, self.y_in_column(i, rng.random::<f64>()))
     }
 
     /// One draw of `x` from its marginal.
@@ -366,11 +400,12 @@ impl InverseCdfSampler2d {
             min: self.x.min,
             max: self.x.max,
         })?;
-        match &self.conditionals[i] {
-            Some(c) => Ok(self.y_in_column(c, rng.random::<f64>())),
-            None => Err(Error::ZeroMass {
+        if self.has_mass[i] {
+            Ok(self.y_in_column(i, rng.random::<f64>()))
+        } else {
+            Err(Error::ZeroMass {
                 context: format!("in the column holding x = {x}"),
-            }),
+            })
         }
     }
 }
