@@ -100,8 +100,8 @@ pub use grading::{GradingCoefficients, GradingCurve, GradingInterpolation, Gradi
 pub use histogram::{BinAxis, Histogram1d, Histogram2d};
 pub use pdf::{Bandwidth, BicubicPdf, GaussianKde2d, TabulatedPdf2d};
 pub use radial::{
-    NeighbourCorrelation, RadialProfiles, SphericalMesh, all_neighbour_correlations,
-    neighbour_correlation,
+    NeighbourCorrelation, NeighbourCorrelationSummary, RadialProfiles, SphericalMesh,
+    all_neighbour_correlations, neighbour_correlation,
 };
 pub use sampling::{
     AcceptanceRejection2d, Density2d, EnvelopeRejection2d, InverseCdfSampler1d, InverseCdfSampler2d,

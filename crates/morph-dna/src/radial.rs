@@ -259,6 +259,52 @@ pub fn all_neighbour_correlations(profiles: &RadialProfiles) -> Result<Vec<Neigh
     Ok(out)
 }
 
+/// Mean of each stencil direction's correlation over a set of ring nodes
+/// (undefined entries skipped), to set beside Medina 2018, Table 2, which
+/// prints one node and states that "similar results are obtained for the
+/// rest of the mesh points".
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NeighbourCorrelationSummary {
+    /// Mean correlation with `(i, j − 1)`, `None` if undefined everywhere.
+    pub j_minus: Option<f64>,
+    /// Mean correlation with `(i − 1, j)`.
+    pub i_minus: Option<f64>,
+    /// Mean correlation with `(i, j + 1)`.
+    pub j_plus: Option<f64>,
+    /// Mean correlation with `(i + 1, j)`.
+    pub i_plus: Option<f64>,
+    /// Number of node pairs with an undefined correlation (constant radius).
+    pub undefined: usize,
+}
+
+impl NeighbourCorrelationSummary {
+    /// Summarises per-node correlations (for example
+    /// [`all_neighbour_correlations`]).
+    pub fn from_nodes(nodes: &[NeighbourCorrelation]) -> Self {
+        let mut undefined = 0;
+        let mut mean = |get: fn(&NeighbourCorrelation) -> Option<f64>| {
+            let (mut sum, mut n) = (0.0, 0usize);
+            for c in nodes {
+                match get(c) {
+                    Some(v) => {
+                        sum += v;
+                        n += 1;
+                    }
+                    None => undefined += 1,
+                }
+            }
+            (n > 0).then(|| sum / n as f64)
+        };
+        Self {
+            j_minus: mean(|c| c.j_minus),
+            i_minus: mean(|c| c.i_minus),
+            j_plus: mean(|c| c.j_plus),
+            i_plus: mean(|c| c.i_plus),
+            undefined,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -325,6 +371,17 @@ mod tests {
         let all = all_neighbour_correlations(&p).expect("ok");
         assert_eq!(all.len(), 10);
         assert_eq!((all[7].i, all[7].j), (2, 2));
+        // Azimuthal links touching a φ = 0 node: 2 per ring, 4 of 10 at r.
+        // Polar links: only each φ = 0 node's pole link is at r (the two
+        // φ = 0 ring nodes correlate with each other at 1).
+        let s = NeighbourCorrelationSummary::from_nodes(&all);
+        assert_eq!(s.undefined, 0);
+        let azimuthal = (6.0 + 4.0 * r) / 10.0;
+        let polar = (9.0 + r) / 10.0;
+        assert_relative_eq!(s.i_minus.expect("defined"), azimuthal, epsilon = 1e-14);
+        assert_relative_eq!(s.i_plus.expect("defined"), azimuthal, epsilon = 1e-14);
+        assert_relative_eq!(s.j_minus.expect("defined"), polar, epsilon = 1e-14);
+        assert_relative_eq!(s.j_plus.expect("defined"), polar, epsilon = 1e-14);
     }
 
     #[test]
@@ -337,6 +394,8 @@ mod tests {
         let c = neighbour_correlation(&same, 0, 1).expect("valid");
         assert_eq!(c.i_plus, None);
         assert_eq!(c.j_minus, None);
+        let s = NeighbourCorrelationSummary::from_nodes(&[c]);
+        assert_eq!((s.i_plus, s.undefined), (None, 4));
         let one = RadialProfiles {
             mesh: m,
             radii: vec![vec![1.0; 5]],
