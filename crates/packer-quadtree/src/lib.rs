@@ -1,13 +1,29 @@
 //! Advancing-front dense packing of disks (Pinto 2009).
 //!
 //! Purpose: fill a 2D domain with non-overlapping disks that follow a
-//! prescribed grading, fast, for DEM codes.
+//! prescribed grading, fast, and write them for DEM codes.
 //!
-//! Key items: [`pack`] / [`pack_sizes`] (the advancing front of Pinto 2009,
-//! Ch. 3) with [`PackParams`]; [`Grading`] (sieve curves with semi-log
-//! inverse-transform sampling, constant, uniform, mixtures);
-//! [`Domain`]; the [`SpatialIndex`] trait with [`CellGrid`] and the seed's
-//! [`MxQuadtree`]; metrics ([`porosity`], [`check_packing`]).
+//! Key items:
+//! * [`pack`] / [`pack_seeded`] / [`pack_sizes`]: the advancing front of
+//!   Pinto 2009, Ch. 3 (front list, search area, halos, candidate centres
+//!   from halo intersections, feasibility, lowest-ordinate rule, front
+//!   removal, Eq. 3-1 size list), configured by [`PackParams`]
+//!   ([`BoundaryMode`], [`HaloMode`], [`FrontOrder`]); every choice the
+//!   seed leaves open is listed in the `packer` module docs;
+//! * [`Grading`]: sieve curves with semi-log inverse-transform sampling
+//!   (§4.2.1), constant, uniform, mixtures (Table 4.1); [`estimate_count`]
+//!   (Eq. 3-1);
+//! * [`Domain`]: rectangle, trapezoid (both orientations), circle, simple
+//!   polygon (self-intersections rejected), fracture slot;
+//! * [`SpatialIndex`] with [`CellGrid`] (default, fastest) and the seed's
+//!   [`MxQuadtree`] (§3.1);
+//! * metrics: [`porosity`] (Eq. 4-2), [`porosity_in_window`],
+//!   [`check_packing`] (independent brute-force overlap/containment check,
+//!   contacts, coordination number, minimum gap);
+//! * [`optimise_porosity`]: genetic porosity control (§4.1–4.2);
+//!   [`graded_layers`]: functionally graded property layers (§4.3);
+//! * writers: [`write_csv`], [`write_vtu`], [`write_lammps_data`],
+//!   [`write_yade`], [`write_svg`].
 //!
 //! ```
 //! use packer_quadtree::{pack, check_packing, porosity, Domain, Grading, PackParams};
@@ -20,13 +36,20 @@
 //! # Ok::<(), packer_quadtree::Error>(())
 //! ```
 //!
-//! Conventions: lengths in the caller's unit (the seed uses mm); gravity
-//! along −y: the front advances upwards, the lowest candidate wins.
+//! Conventions: lengths in the caller's unit (the seed and the tests use
+//! mm); gravity along −y: the front advances upwards and the lowest
+//! candidate wins, ties to the left; 2D disks are exported as spheres at
+//! `z = 0`. Determinism: sizes come from the caller's seeded RNG; the
+//! packer itself is deterministic and independent of the spatial index;
+//! the genetic algorithm derives per-individual ChaCha8 streams from
+//! `(seed, index)` and gives identical results for any thread count.
 //!
 //! References: Pinto, R. C. (2009), *Geração de arranjos de partículas para
-//! o método dos elementos discretos*, MSc thesis, PUC-Rio,
-//! doi:10.17771/PUCRio.acad.14425; Feng, Han & Owen (2003),
-//! doi:10.1002/nme.827.
+//! o método dos elementos discretos*, MSc thesis, PUC-Rio
+//! (Certificação Digital 0721419/CA); Feng, Han & Owen (2003), Filling
+//! domains with disks: an advancing front approach, IJNME 56,
+//! doi:10.1002/nme.583; Samet (1990), The Design and Analysis of Spatial
+//! Data Structures (MX quadtree).
 
 // Seeded randomised tests print their seed (house style).
 #![cfg_attr(test, allow(clippy::print_stdout))]
