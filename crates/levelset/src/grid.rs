@@ -223,8 +223,6 @@ impl Grid {
         self.values[self.index(i, j, k)]
     }
 
-    pub(crate) fn from_parts_unchecked(spec: GridSpec, values: Vec<f64>) -> Self {
-        Self { spec, values }
     }
 
     pub(crate) fn values_mut(&mut self) -> &mut [f64] {

@@ -62,8 +62,8 @@ impl StarParams {
     }
 }
 
-/// Magnitude standing for "far from the interface, distance unknown" before sweeping.
-const FAR: f64 = 1e300;
+/// Marker for "far from the interface, distance unknown" before sweeping.
+const FAR: f64 = f64::INFINITY;
 
 /// Diagnostics of a star build.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -234,12 +234,11 @@ impl Grid {
                 calls = count;
             }
         }
-        if let Some((index, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(Error::NonFiniteValue { index, value });
-        }
+        // Far nodes hold ±∞ until the sweeps (which reach every node) give them a distance;
+        // `Grid::new` re-checks that everything ended finite.
         redistance(&spec, &mut values, true)?;
         Ok((
-            Grid::from_parts_unchecked(spec, values),
+            Grid::new(spec, values)?,
             StarBuild {
                 radius_calls: calls,
             },
