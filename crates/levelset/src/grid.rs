@@ -223,8 +223,6 @@ impl Grid {
         self.values[self.index(i, j, k)]
     }
 
-    }
-
     pub(crate) fn values_mut(&mut self) -> &mut [f64] {
         &mut self.values
     }
