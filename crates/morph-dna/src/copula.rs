@@ -177,6 +177,131 @@ impl GaussianCopula {
         }
         Ok(t)
     }
+
+    /// Empirical CDF of descriptor number `d` at `x`: the inverse of
+    /// [`GaussianCopula::quantile`], clamped to the plotting positions
+    /// `[1/(2n), 1 − 1/(2n)]`; tied order statistics map to the middle of
+    /// their span.
+    fn cdf(&self, d: usize, x: f64) -> f64 {
+        let s = &self.sorted[d];
+        let n = s.len() as f64;
+        let lo = s.partition_point(|v| *v < x);
+        let hi = s.partition_point(|v| *v <= x);
+        if hi > lo {
+            // x equals order statistics lo..hi (0-based): middle of their positions.
+            return ((lo + hi) as f64 / 2.0) / n;
+        }
+        if lo == 0 {
+            return 0.5 / n;
+        }
+        if lo == s.len() {
+            return 1.0 - 0.5 / n;
+        }
+        let (a, b) = (s[lo - 1], s[lo]);
+        (lo as f64 - 0.5 + (x - a) / (b - a)) / n
+    }
+
+    /// One draw of every descriptor conditional on the values of some of
+    /// them, in [`GaussianCopula::descriptors`] order (the given descriptors
+    /// are returned at their given values).
+    ///
+    /// The given values are mapped to normal scores through the empirical
+    /// CDFs (values beyond the observed range count as the extremes), and
+    /// the remaining scores are drawn from the conditional normal
+    /// `N(R_BA R_AA⁻ z_A, R_BB − R_BA R_AA⁻ R_AB)`. If the given descriptors
+    /// are themselves perfectly dependent (e.g. volume and equivalent
+    /// diameter), `R_AA⁻` is the generalised inverse of the semidefinite
+    /// factor and the redundant given value is ignored.
+    ///
+    /// # Errors
+    /// [`Error::MissingDescriptor`], [`Error::DuplicateDescriptor`],
+    /// [`Error::NonFiniteSample`] for a NaN or infinite given value.
+    pub fn sample_conditional(
+        &self,
+        given: &[(Descriptor, f64)],
+        rng: &mut impl Rng,
+    ) -> Result<Vec<f64>> {
+        let k = self.descriptors.len();
+        let mut is_given = vec![None; k];
+        for (index, (d, v)) in given.iter().enumerate() {
+            let p = self
+                .descriptors
+                .iter()
+                .position(|x| x == d)
+                .ok_or(Error::MissingDescriptor { descriptor: *d })?;
+            if is_given[p].is_some() {
+                return Err(Error::DuplicateDescriptor { descriptor: *d });
+            }
+            if !v.is_finite() {
+                return Err(Error::NonFiniteSample { index, value: *v });
+            }
+            is_given[p] = Some(*v);
+        }
+        let a: Vec<usize> = (0..k).filter(|i| is_given[*i].is_some()).collect();
+        let b: Vec<usize> = (0..k).filter(|i| is_given[*i].is_none()).collect();
+        let r = |i: usize, j: usize| self.correlation[i * k + j];
+        let za: Vec<f64> = a
+            .iter()
+            .map(|&i| normal_quantile(self.cdf(i, is_given[i].unwrap_or(0.0))))
+            .collect();
+        // Generalised solve with the semidefinite factor of R_AA.
+        let na = a.len();
+        let raa: Vec<f64> = a
+            .iter()
+            .flat_map(|&i| a.iter().map(move |&j| r(i, j)))
+            .collect();
+        let laa = semidefinite_cholesky(&raa, na)?;
+        let solve = |rhs: &[f64]| -> Vec<f64> {
+            let mut y = vec![0.0; na];
+            for i in 0..na {
+                let d = laa[i * na + i];
+                if d > 0.0 {
+                    let s: f64 = (0..i).map(|p| laa[i * na + p] * y[p]).sum();
+                    y[i] = (rhs[i] - s) / d;
+                }
+            }
+            let mut x = vec![0.0; na];
+            for i in (0..na).rev() {
+                let d = laa[i * na + i];
+                if d > 0.0 {
+                    let s: f64 = ((i + 1)..na).map(|p| laa[p * na + i] * x[p]).sum();
+                    x[i] = (y[i] - s) / d;
+                }
+            }
+            x
+        };
+        let w = solve(&za);
+        let nb = b.len();
+        let mut mean = vec![0.0; nb];
+        let mut cov = vec![0.0; nb * nb];
+        let cols: Vec<Vec<f64>> = b
+            .iter()
+            .map(|&j| solve(&a.iter().map(|&i| r(i, j)).collect::<Vec<_>>()))
+            .collect();
+        for (p, &i) in b.iter().enumerate() {
+            mean[p] = a.iter().zip(&w).map(|(&q, wq)| r(i, q) * wq).sum();
+            for (q, &j) in b.iter().enumerate() {
+                let reduce: f64 = a.iter().zip(&cols[q]).map(|(&m, c)| r(i, m) * c).sum();
+                cov[p * nb + q] = r(i, j) - reduce;
+            }
+        }
+        // Symmetrise against rounding before factorising.
+        for p in 0..nb {
+            for q in 0..p {
+                let v = 0.5 * (cov[p * nb + q] + cov[q * nb + p]);
+                cov[p * nb + q] = v;
+                cov[q * nb + p] = v;
+            }
+        }
+        let lb = semidefinite_cholesky(&cov, nb)?;
+        let e: Vec<f64> = (0..nb).map(|_| StandardNormal.sample(rng)).collect();
+        let mut out: Vec<f64> = is_given.iter().map(|g| g.unwrap_or(0.0)).collect();
+        for (p, &i) in b.iter().enumerate() {
+            let z = mean[p] + (0..=p).map(|q| lb[p * nb + q] * e[q]).sum::<f64>();
+            out[i] = self.quantile(i, normal_cdf(z));
+        }
+        Ok(out)
+    }
 }
 
 #[cfg(test)]
@@ -246,6 +371,58 @@ mod tests {
         assert!(matches!(
             GaussianCopula::fit(&one),
             Err(Error::TooFewSamples { .. })
+        ));
+    }
+
+    #[test]
+    fn empirical_cdf_inverts_the_quantile() {
+        let t =
+            DnaTable::from_columns(vec![Volume], vec![vec![4.0, 1.0, 3.0, 2.0, 2.0]]).expect("ok");
+        let c = GaussianCopula::fit(&t).expect("fit");
+        for u in [0.1, 0.15, 0.55, 0.7, 0.85, 0.9] {
+            assert_relative_eq!(c.cdf(0, c.quantile(0, u)), u, epsilon = 1e-12);
+        }
+        // The tie at 2 holds plotting positions 0.3 and 0.5: middle 0.4.
+        assert_relative_eq!(c.cdf(0, 2.0), 0.4);
+        assert_relative_eq!(c.cdf(0, -5.0), 0.1);
+        assert_relative_eq!(c.cdf(0, 50.0), 0.9);
+    }
+
+    #[test]
+    fn conditional_sampling_validates_and_keeps_given_values() {
+        let t = DnaTable::from_columns(
+            vec![Volume, Roundness, AspectRatio],
+            vec![
+                vec![1.0, 2.0, 3.0, 4.0, 5.0],
+                vec![0.2, 0.1, 0.4, 0.3, 0.5],
+                vec![0.5, 0.6, 0.6, 0.9, 0.7],
+            ],
+        )
+        .expect("ok");
+        let c = GaussianCopula::fit(&t).expect("fit");
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let v = c
+            .sample_conditional(&[(Roundness, 0.33)], &mut rng)
+            .expect("valid");
+        assert_relative_eq!(v[1], 0.33);
+        assert!((1.0..=5.0).contains(&v[0]) && (0.5..=0.9).contains(&v[2]));
+        // Everything given: returned as is.
+        let all = [(Volume, 2.5), (Roundness, 0.3), (AspectRatio, 0.8)];
+        let got = c.sample_conditional(&all, &mut rng).expect("ok");
+        for (g, (_, v)) in got.iter().zip(&all) {
+            assert_relative_eq!(*g, *v);
+        }
+        assert!(matches!(
+            c.sample_conditional(&[(Sphericity, 0.3)], &mut rng),
+            Err(Error::MissingDescriptor { .. })
+        ));
+        assert!(matches!(
+            c.sample_conditional(&[(Volume, 1.0), (Volume, 2.0)], &mut rng),
+            Err(Error::DuplicateDescriptor { .. })
+        ));
+        assert!(matches!(
+            c.sample_conditional(&[(Volume, f64::NAN)], &mut rng),
+            Err(Error::NonFiniteSample { .. })
         ));
     }
 

@@ -146,7 +146,12 @@ fn seeded_sampling_is_deterministic() {
     let s = InverseCdfSampler2d::new(&TabulatedPdf2d::from_histogram(&h).expect("valid"));
     let draw = |seed: u64| {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        (0..100).map(|_| s.sample(&mut rng)).collect::<Vec<_>>()
+        (0..100)
+            .map(|_| {
+                let (x, y) = s.sample(&mut rng);
+                (x.to_bits(), y.to_bits())
+            })
+            .collect::<Vec<_>>()
     };
     assert_eq!(draw(3), draw(3));
     assert_ne!(draw(3), draw(4));
@@ -208,4 +213,63 @@ proptest! {
             prop_assert!(ar.pdf().density(u, v) > 0.0);
         }
     }
+}
+
+/// Conditioning on two of the four Table 1 descriptors: with standard normal
+/// marginals the copula is the Gaussian itself, so the conditional mean and
+/// covariance of the other two have the closed form
+/// `μ = R_BA R_AA⁻¹ z_A`, `Σ = R_BB − R_BA R_AA⁻¹ R_AB`.
+#[test]
+fn copula_conditional_matches_gaussian_conditioning() {
+    let seed = 53;
+    #[expect(clippy::print_stdout, reason = "seeded tests print their seed")]
+    {
+        println!("seed {seed}");
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let cols = normal_population(&TABLE_1, 100_000, &mut rng);
+    let parents =
+        DnaTable::from_columns(Descriptor::MEDINA_2018_TABLE_1.to_vec(), cols).expect("valid");
+    let copula = GaussianCopula::fit(&parents).expect("fit");
+    // A = {aspect ratio (0), roundness (1)}, B = {VSR (2), min p. dim. (3)}.
+    let za = [0.5, -0.3];
+    let r = |i: usize, j: usize| TABLE_1[i * 4 + j];
+    let det = 1.0 - r(0, 1) * r(0, 1);
+    let inv = [1.0 / det, -r(0, 1) / det, -r(0, 1) / det, 1.0 / det];
+    let rba = |b: usize| [r(b, 0), r(b, 1)];
+    let quad = |u: [f64; 2], v: [f64; 2]| {
+        u[0] * (inv[0] * v[0] + inv[1] * v[1]) + u[1] * (inv[2] * v[0] + inv[3] * v[1])
+    };
+    let mean = [quad(rba(2), za), quad(rba(3), za)];
+    let var = [1.0 - quad(rba(2), rba(2)), 1.0 - quad(rba(3), rba(3))];
+    let cov23 = r(2, 3) - quad(rba(2), rba(3));
+    let given = [(AspectRatio, za[0]), (Roundness, za[1])];
+    let n = 20_000;
+    let draws: Vec<Vec<f64>> = (0..n)
+        .map(|_| copula.sample_conditional(&given, &mut rng).expect("valid"))
+        .collect();
+    let col = |k: usize| draws.iter().map(|d| d[k]).collect::<Vec<f64>>();
+    let (v, m) = (col(2), col(3));
+    for (k, x) in [(0, &v), (1, &m)] {
+        let mu = x.iter().sum::<f64>() / n as f64;
+        let sd = morph_dna::stats::sample_std(x).expect("ok");
+        assert!((mu - mean[k]).abs() < 0.02, "mean {mu} vs {}", mean[k]);
+        assert!(
+            (sd - var[k].sqrt()).abs() < 0.02,
+            "std {sd} vs {}",
+            var[k].sqrt()
+        );
+    }
+    let rho = cov23 / (var[0] * var[1]).sqrt();
+    let got = pearson(&v, &m).expect("ok");
+    assert!(
+        (got - rho).abs() < 0.03,
+        "conditional correlation {got} vs {rho}"
+    );
+    // Given values are returned bit for bit.
+    assert!(
+        draws
+            .iter()
+            .all(|d| d[0].to_bits() == za[0].to_bits() && d[1].to_bits() == za[1].to_bits())
+    );
 }
