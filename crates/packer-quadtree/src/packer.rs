@@ -583,7 +583,7 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
         let mut index = I::with_bounds(
             Point2::new(lo[0] - pad, lo[1] - pad),
             Point2::new(hi[0] + pad, hi[1] + pad),
-            d_max,
+            2.0 * d_max,
             sizes.len(),
         );
         let mut xs = Vec::with_capacity(sizes.len().min(1 << 24));
