@@ -181,6 +181,13 @@ pub enum Error {
         /// Where the mass is missing.
         context: String,
     },
+    /// A rejection sampler hit its proposal limit (the conditional slice has
+    /// little or no mass).
+    #[error("no proposal accepted in {trials} trials")]
+    TooManyRejections {
+        /// The limit that was reached.
+        trials: usize,
+    },
     /// A query point is outside the support of a distribution.
     #[error("{value} is outside the support [{min}, {max}]")]
     OutsideSupport {

@@ -15,7 +15,9 @@
 //!   [`EnvelopeRejection2d`] (the same target with a per-bin envelope),
 //!   [`InverseCdfSampler1d`] / [`InverseCdfSampler2d`] (exact tabulated
 //!   inverse CDF with conditional draws), [`GaussianCopula`] (joint model of
-//!   all descriptors).
+//!   all descriptors, with draws conditional on any given descriptors).
+//!   Conditional draws `y | x` (the cloner's quality control, Medina 2018
+//!   §2.4) exist for the rejection, inverse-CDF and copula samplers.
 //! * [`GradingCurve`] with D10/D30/D60, Cu and Cc.
 //! * [`compare_populations`]: Medina 2018 Tables 4–5 errors, KS, W1 and
 //!   correlation-matrix differences.

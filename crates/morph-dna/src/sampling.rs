@@ -95,6 +95,33 @@ impl<D: Density2d> AcceptanceRejection2d<D> {
         &self.pdf
     }
 
+    /// One draw of `y` given `x` by rejection on the slice `f(x, ·)` (the
+    /// seed's Monte Carlo applied to the quality control of Medina 2018,
+    /// §2.4): propose `y` uniformly, accept with probability `f(x, y) / M`.
+    /// The expected number of proposals is `M · height / ∫f(x, y) dy`, large
+    /// where the slice carries little mass, hence the limit `max_trials`;
+    /// [`InverseCdfSampler2d::sample_y_given_x`] has no such limit.
+    ///
+    /// # Errors
+    /// [`Error::OutsideSupport`] for `x` outside the support,
+    /// [`Error::TooManyRejections`] after `max_trials` rejected proposals.
+    pub fn sample_y_given_x(&self, x: f64, max_trials: usize, rng: &mut impl Rng) -> Result<f64> {
+        if !(x >= self.x.0 && x <= self.x.1) {
+            return Err(Error::OutsideSupport {
+                value: x,
+                min: self.x.0,
+                max: self.x.1,
+            });
+        }
+        for _ in 0..max_trials {
+            let y = self.y.0 + (self.y.1 - self.y.0) * rng.random::<f64>();
+            if rng.random::<f64>() * self.bound < self.pdf.density(x, y) {
+                return Ok(y);
+            }
+        }
+        Err(Error::TooManyRejections { trials: max_trials })
+    }
+
     /// One draw.
     pub fn sample(&self, rng: &mut impl Rng) -> (f64, f64) {
         loop {
@@ -489,6 +516,20 @@ mod tests {
         ));
         let ar = AcceptanceRejection2d::new(t).expect("ok");
         assert_relative_eq!(ar.expected_trials(), 4.0);
+        for _ in 0..50 {
+            let c = ar
+                .sample_y_given_x(0.3, 1000, &mut rng)
+                .expect("column 0 has mass");
+            assert!((1.0..=2.0).contains(&c));
+        }
+        assert_eq!(
+            ar.sample_y_given_x(1.5, 100, &mut rng),
+            Err(Error::TooManyRejections { trials: 100 })
+        );
+        assert!(matches!(
+            ar.sample_y_given_x(-0.1, 100, &mut rng),
+            Err(Error::OutsideSupport { .. })
+        ));
         for _ in 0..200 {
             let (a, b) = ar.sample(&mut rng);
             assert!((0.0..1.0).contains(&a) && (1.0..=2.0).contains(&b));

@@ -139,13 +139,24 @@ fn every_sampler_reproduces_a_correlated_bivariate_normal() {
         })
         .collect();
     let kc = ks_distance_to_cdf(&cond, |v| normal_cdf((v - m) / s)).expect("finite");
+    let cond: Vec<f64> = (0..N_DRAWS)
+        .map(|_| {
+            ar.sample_y_given_x(x0, 10_000, &mut rng)
+                .expect("slice has mass")
+        })
+        .collect();
+    let ka = ks_distance_to_cdf(&cond, |v| normal_cdf((v - m) / s)).expect("finite");
     #[expect(
         clippy::print_stdout,
         reason = "the acceptance numbers go into the report"
     )]
     {
-        println!("conditional Y | X = {x0}: inverse CDF KS = {k:.4}, copula KS = {kc:.4}");
+        println!(
+            "conditional Y | X = {x0}: inverse CDF KS = {k:.4}, copula KS = {kc:.4}, \
+             acceptance-rejection KS = {ka:.4}"
+        );
     }
+    assert!(ka <= KS_MAX, "acceptance-rejection conditional KS = {ka}");
     assert!(k <= KS_MAX, "inverse-CDF conditional KS = {k}");
     assert!(kc <= KS_MAX, "copula conditional KS = {kc}");
 }
