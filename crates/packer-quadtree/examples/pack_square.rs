@@ -1,7 +1,8 @@
 //! Packs one square (or rectangle) with the Table 3.4 grading of Pinto 2009
 //! and prints count, porosity and wall time: used to measure peak memory
 //! with `/usr/bin/time -v` (e.g. `cargo run --release -p packer-quadtree
-//! --example pack_square -- 3300 3300` for about 10⁷ disks).
+//! --example pack_square -- 3873 3873` for about 10⁷ disks; append `1` for
+//! the default best-of front order instead of the stack order).
 #![allow(clippy::print_stdout, reason = "an example reports to the terminal")]
 
 use packer_quadtree::{Domain, FrontOrder, Grading, PackParams, pack, porosity};
@@ -19,9 +20,14 @@ fn main() -> Result<(), packer_quadtree::Error> {
         height: h,
     };
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
-    let params = PackParams {
-        front_order: FrontOrder::Stack,
-        ..PackParams::default()
+    // A third argument `1` selects the default (best-of) front order.
+    let params = if args.get(2) == Some(&1.0) {
+        PackParams::default()
+    } else {
+        PackParams {
+            front_order: FrontOrder::Stack,
+            ..PackParams::default()
+        }
     };
     let t = std::time::Instant::now();
     let p = pack(&domain, &Grading::pinto_table_3_4(), &params, &mut rng)?;

@@ -108,6 +108,11 @@ pub struct PackParams {
     pub halo: HaloMode,
     /// Front-list order.
     pub front_order: FrontOrder,
+    /// The seed's shortcut (Pinto 2009, §3: "se não houver … pelo menos
+    /// duas [boas interseções], a frente também é removida"): a front with a
+    /// single feasible candidate is removed after receiving its particle.
+    /// `false` keeps it until it has no feasible candidate at all.
+    pub remove_single: bool,
     /// Upper bound on the Eq. 3-1 estimate (guards against a unit mistake
     /// exhausting memory).
     pub max_particles: usize,
@@ -119,6 +124,7 @@ impl Default for PackParams {
             boundary: BoundaryMode::Exact,
             halo: HaloMode::ParticleDiameter,
             front_order: FrontOrder::Best,
+            remove_single: true,
             max_particles: 100_000_000,
         }
     }
@@ -511,6 +517,7 @@ struct Packer<'a, I> {
     sizes: &'a [f64],
     r_max: f64,
     halo: HaloMode,
+    remove_single: bool,
     tol: f64,
     index: I,
     xs: Vec<[f64; 3]>,
@@ -624,6 +631,7 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
             sizes,
             r_max,
             halo: params.halo,
+            remove_single: params.remove_single,
             tol: 1e-10 * d_max,
             index,
             n_boundary: xs.len(),
@@ -823,7 +831,7 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
                     self.stats.fronts_removed += 1;
                 }
                 Some(p) => {
-                    if good < 2 {
+                    if good < 2 && self.remove_single {
                         self.fronts.pop();
                         self.stats.fronts_removed += 1;
                     }
@@ -878,7 +886,7 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
             self.xs.push(q);
             self.index.insert(id, Point2::new(p[0], p[1]));
             k += 1;
-            if good >= 2 {
+            if good >= 2 || !self.remove_single {
                 // Keys only grow for a fixed size: the old key is a valid
                 // lower bound until the front is popped again.
                 heap.push(Key {
