@@ -516,6 +516,8 @@ struct Packer<'a, I> {
     exact: bool,
     sizes: &'a [f64],
     r_max: f64,
+    /// Largest obstacle radius (particles and boundary circles).
+    r_obstacle: f64,
     halo: HaloMode,
     remove_single: bool,
     tol: f64,
@@ -630,6 +632,7 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
             exact,
             sizes,
             r_max,
+            r_obstacle: boundary.iter().map(|b| b[2]).fold(r_max, f64::max),
             halo: params.halo,
             remove_single: params.remove_single,
             tol: 1e-10 * d_max,
@@ -748,8 +751,13 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
         let f = self.xs[fi as usize];
         let cf = [f[0], f[1]];
         let rho = f[2] + rh;
-        let reach = f[2] + self.r_max + 2.0 * rh + self.tol;
+        let reach = f[2] + self.r_obstacle + 2.0 * rh + self.tol;
         let Scratch { ids, nb, cand } = scratch;
+        // A front in an INSIDE wall cell is farther than 3 r_max from every
+        // wall, and every candidate lies within r_f + r_h <= 2 r_max of it:
+        // the domain test is then always true and is skipped.
+        let front_cell = self.wall_grid.cell(cf);
+        let interior = front_cell.is_some_and(|k| self.wall_grid.kind[k] == INSIDE);
         ids.clear();
         self.index.query(
             Point2::new(cf[0] - reach, cf[1] - reach),
@@ -772,7 +780,8 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
             }
         }
         if self.exact
-            && let Some(kc) = self.wall_grid.cell(cf)
+            && !interior
+            && let Some(kc) = front_cell
         {
             for &wi in self.wall_grid.near(kc) {
                 circle_wall(cf, rho, &self.walls[wi as usize], rh, cand);
@@ -795,7 +804,7 @@ impl<'a, I: SpatialIndex> Packer<'a, I> {
                 let m = o[2] - self.tol;
                 dx * dx + dy * dy >= m * m
             });
-            if clear && self.in_domain(p, rh) {
+            if clear && (interior || self.in_domain(p, rh)) {
                 match &best {
                     Some(b1) if !below(&p, b1) => second = Some(p),
                     _ => {

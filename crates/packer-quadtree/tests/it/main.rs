@@ -327,13 +327,13 @@ fn arb_grading() -> impl Strategy<Value = Grading> {
 }
 
 fn arb_params() -> impl Strategy<Value = PackParams> {
+    // Boundary circles smaller than and larger than the particles, or exact
+    // walls.
     (0..3usize, 0..2usize, 0..4usize).prop_map(|(b, h, o)| PackParams {
-        boundary: if b == 0 {
-            BoundaryMode::Circles {
-                factor: 0.3 + 0.35 * b as f64,
-            }
-        } else {
-            BoundaryMode::Exact
+        boundary: match b {
+            0 => BoundaryMode::Circles { factor: 0.3 },
+            1 => BoundaryMode::Circles { factor: 2.5 },
+            _ => BoundaryMode::Exact,
         },
         halo: if h == 0 {
             HaloMode::ParticleDiameter
