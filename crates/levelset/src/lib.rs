@@ -1,5 +1,65 @@
-//! Signed-distance (level-set) grids of grains — the grain representation of
-//! LS-DEM (Kawamoto et al. 2016) and of GSC 2.0 (Medina 2018).
+//! Signed-distance (level-set) grids of grains — the grain representation of LS-DEM
+//! (Kawamoto et al. 2016) and of GSC 2.0 (Medina 2018, 45³ level sets).
+//!
+//! # Key types
+//! * [`Grid`] / [`GridSpec`]: uniform grid of signed distances, negative inside, x fastest;
+//!   trilinear [`Grid::value`], corrected [`Grid::sample`] (value + gradient),
+//!   [`Grid::closest_point`], [`Grid::surface_nodes`].
+//! * Construction: analytic [`Shape`]s ([`Sphere`], [`Ellipsoid`], [`Cuboid`], [`Cylinder`])
+//!   via [`Grid::from_shape`]; [`Superellipsoid`] and any star-shaped radius function via
+//!   [`Grid::from_star`] (cube-map direction table + fast sweeping, [`StarParams`]);
+//!   closed triangle meshes via [`Grid::from_mesh`] ([`MeshDistance`]: BVH + pseudonormals);
+//!   voxel images via [`Grid::from_voxels`] (exact EDT) and [`Grid::from_grayscale`];
+//!   [`Grid::reinitialise`] (fast sweeping).
+//! * Properties on request: [`Grid::volume`], [`Grid::area`], [`Grid::mass_properties`]
+//!   ([`MassProperties::principal`]), [`Grid::bounding_box`], [`Grid::inscribed_sphere`],
+//!   [`Grid::equivalent_diameter`].
+//! * [`Grid::marching_cubes`] → [`TriMesh`] (closed, oriented, shared vertices).
+//! * LS-DEM contact: [`Body`], [`contact()`] / [`contact_into`] → [`NodeContact`].
+//! * [`io`]: LS-DEM morph files, LAMMPS LSDEM grid files, VTK structured points, STL.
+//!
+//! # Example
+//! ```
+//! use levelset::nalgebra::{Isometry3, Point3, Vector3};
+//! use levelset::{Body, Grid, GridSpec, Sphere, StarParams, contact};
+//!
+//! // A 45³ grid over [−1.2, 1.2]³ holding a lumpy star-shaped grain.
+//! let spec = GridSpec::cube(45, -1.2, 1.2)?;
+//! let (grain, build) = Grid::from_star(
+//!     spec,
+//!     &Point3::origin(),
+//!     |u| 0.9 + 0.1 * u.x * u.y,
+//!     &StarParams::default(),
+//! )?;
+//! assert_eq!(build.radius_calls, 6 * 33 * 33);
+//! let mp = grain.mass_properties()?;
+//! assert!(mp.volume > 2.5 && mp.volume < 3.6);
+//!
+//! // Two unit spheres overlapping by 0.1: LS-DEM node-to-grid contact.
+//! let sphere = Grid::from_shape(spec, &Sphere::new(1.0)?, &Isometry3::identity())?;
+//! let nodes = sphere.surface_nodes(500)?;
+//! let body = Body::new(sphere, nodes)?;
+//! let other = Isometry3::translation(1.9, 0.0, 0.0);
+//! let hits = contact(&body, &Isometry3::identity(), &body, &other);
+//! let deepest = hits.iter().map(|c| c.penetration).fold(0.0, f64::max);
+//! assert!(deepest > 0.08 && deepest <= 0.1 + 1e-3);
+//! # let _ = Vector3::<f64>::zeros();
+//! # Ok::<(), levelset::Error>(())
+//! ```
+//!
+//! # Conventions
+//! * φ < 0 inside, |∇φ| = 1 near the surface; node `(i, j, k)` at `origin + h·(i, j, k)`,
+//!   stored at `i + nx·(j + ny·k)`.
+//! * Body frames: a [`Body`]'s grid and nodes share one frame; poses map body → world.
+//! * Properties are per unit density; lengths in the grid's units.
+//!
+//! # References
+//! * Kawamoto, Andò, Viggiani, Andrade 2016, J. Mech. Phys. Solids 91,
+//!   doi:10.1016/j.jmps.2016.02.021 (LS-DEM).
+//! * Zhao 2005, Math. Comp. 74, doi:10.1090/S0025-5718-04-01678-3 (fast sweeping).
+//! * Bærentzen & Aanæs 2005, IEEE TVCG 11, doi:10.1109/TVCG.2005.49 (pseudonormals).
+//! * Felzenszwalb & Huttenlocher 2012, Theory Comput. 8, doi:10.4086/toc.2012.v008a019 (EDT).
+//! * Lorensen & Cline 1987, doi:10.1145/37402.37422 (marching cubes).
 //!
 //! Layer 0: no internal dependencies (see `docs/architecture.md`).
 
@@ -14,6 +74,9 @@ pub mod shapes;
 pub mod star;
 pub mod surface;
 pub mod voxel;
+
+/// Re-export of the vector vocabulary of the API, so callers need no separate pin.
+pub use nalgebra;
 
 pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};

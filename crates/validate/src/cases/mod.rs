@@ -4,6 +4,7 @@
 use crate::{Case, ExpectedFailure};
 
 mod fixture_integrity;
+mod levelset;
 mod packer_quadtree;
 mod rounding;
 
@@ -12,6 +13,7 @@ mod rounding;
 pub fn registry() -> Vec<Case> {
     let mut cases = Vec::new();
     cases.extend(fixture_integrity::cases());
+    cases.extend(levelset::cases());
     cases.extend(packer_quadtree::cases());
     cases
 }
@@ -21,6 +23,7 @@ pub fn registry() -> Vec<Case> {
 pub fn expected_failures() -> Vec<ExpectedFailure> {
     let mut list = Vec::new();
     list.extend_from_slice(fixture_integrity::EXPECTED_FAILURES);
+    list.extend_from_slice(levelset::EXPECTED_FAILURES);
     list.extend_from_slice(packer_quadtree::EXPECTED_FAILURES);
     list
 }
