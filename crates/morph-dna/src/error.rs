@@ -163,6 +163,17 @@ pub enum Error {
         /// The value.
         value: usize,
     },
+    /// A bin, cell or refinement count exceeds the crate's limit
+    /// ([`crate::histogram::MAX_CELLS`]) or overflows.
+    #[error("{what} = {value} exceeds the limit {max}")]
+    CountTooLarge {
+        /// Which count.
+        what: &'static str,
+        /// The limit.
+        max: usize,
+        /// The requested count (saturated on overflow).
+        value: usize,
+    },
     /// A range is empty, reversed or not finite.
     #[error("invalid range [{min}, {max}]")]
     InvalidRange {

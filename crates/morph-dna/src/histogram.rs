@@ -12,6 +12,23 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::stats::{check_sample, constant_value};
 
+/// Largest number of bins of an axis and of cells of a 2D grid or table
+/// (2²⁶ ≈ 6.7 × 10⁷): larger requests are an [`Error::CountTooLarge`]
+/// rather than an allocation failure.
+pub const MAX_CELLS: usize = 1 << 26;
+
+/// `a · b` if it does not exceed [`MAX_CELLS`].
+pub(crate) fn checked_cells(what: &'static str, a: usize, b: usize) -> Result<usize> {
+    match a.checked_mul(b) {
+        Some(n) if n <= MAX_CELLS => Ok(n),
+        other => Err(Error::CountTooLarge {
+            what,
+            max: MAX_CELLS,
+            value: other.unwrap_or(usize::MAX),
+        }),
+    }
+}
+
 /// An equal-width binning of a closed interval.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct BinAxis {
@@ -47,6 +64,7 @@ impl BinAxis {
                 value: 0,
             });
         }
+        checked_cells("bins", self.bins, 1)?;
         let ordered = self.min.is_finite() && self.max.is_finite() && self.min < self.max;
         let width = (self.max - self.min) / self.bins as f64;
         if !ordered || !width.is_normal() {
@@ -203,7 +221,7 @@ impl Histogram2d {
             Some((a, b)) => BinAxis::new(a, b, bins.1)?,
             None => BinAxis::spanning(y, bins.1)?,
         };
-        let mut counts = vec![0u64; ax.bins * ay.bins];
+        let mut counts = vec![0u64; checked_cells("cells", ax.bins, ay.bins)?];
         let mut outside = 0;
         for (u, v) in x.iter().zip(y) {
             match (ax.bin_of(*u), ay.bin_of(*v)) {
@@ -272,6 +290,28 @@ mod tests {
         assert_eq!(h.counts.iter().filter(|c| **c == 0).count(), 4);
         let d = h.density();
         assert_relative_eq!(d.iter().sum::<f64>() * h.x.width() * h.y.width(), 1.0);
+    }
+
+    #[test]
+    fn oversized_grids_are_errors_not_allocation_failures() {
+        assert!(matches!(
+            Histogram1d::new(&[0.5], usize::MAX, Some((0.0, 1.0))),
+            Err(Error::CountTooLarge { what: "bins", .. })
+        ));
+        assert!(matches!(
+            Histogram2d::new(&[0.5, 0.7], &[0.5, 0.6], (1 << 20, 1 << 20), None, None),
+            Err(Error::CountTooLarge { what: "cells", .. })
+        ));
+        let h = Histogram2d::new(&[0.5, 0.7], &[0.5, 0.6], (4, 4), None, None).expect("ok");
+        assert!(matches!(
+            crate::pdf::BicubicPdf::from_histogram(&h, usize::MAX),
+            Err(Error::CountTooLarge { .. })
+        ));
+        let p = crate::pdf::BicubicPdf::from_histogram(&h, 2).expect("ok");
+        assert!(matches!(
+            p.tabulate(1 << 13),
+            Err(Error::CountTooLarge { .. })
+        ));
     }
 
     #[test]

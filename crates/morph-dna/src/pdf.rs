@@ -8,7 +8,7 @@ use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::histogram::{BinAxis, Histogram2d};
+use crate::histogram::{BinAxis, Histogram2d, checked_cells};
 use crate::stats::{check_len, check_sample, constant_value, mean_unchecked};
 
 /// A piecewise-constant bivariate density on the cells of two [`BinAxis`]es,
@@ -33,7 +33,7 @@ impl TabulatedPdf2d {
     pub fn new(x: BinAxis, y: BinAxis, weights: Vec<f64>) -> Result<Self> {
         x.validate()?;
         y.validate()?;
-        let n = x.bins * y.bins;
+        let n = checked_cells("cells", x.bins, y.bins)?;
         if weights.len() != n {
             return Err(Error::RaggedTable {
                 what: "density table",
@@ -149,9 +149,10 @@ impl BicubicPdf {
             max_node,
         };
         let (fx, fy) = (
-            BinAxis::new(h.x.min, h.x.max, h.x.bins * refine)?,
-            BinAxis::new(h.y.min, h.y.max, h.y.bins * refine)?,
+            BinAxis::new(h.x.min, h.x.max, checked_cells("bins", h.x.bins, refine)?)?,
+            BinAxis::new(h.y.min, h.y.max, checked_cells("bins", h.y.bins, refine)?)?,
         );
+        checked_cells("cells", fx.bins, fy.bins)?;
         let mut mass = 0.0;
         for i in 0..fx.bins {
             for j in 0..fy.bins {
@@ -249,9 +250,17 @@ impl BicubicPdf {
                 value: 0,
             });
         }
-        let fx = BinAxis::new(self.x.min, self.x.max, self.x.bins * refine)?;
-        let fy = BinAxis::new(self.y.min, self.y.max, self.y.bins * refine)?;
-        let mut w = Vec::with_capacity(fx.bins * fy.bins);
+        let fx = BinAxis::new(
+            self.x.min,
+            self.x.max,
+            checked_cells("bins", self.x.bins, refine)?,
+        )?;
+        let fy = BinAxis::new(
+            self.y.min,
+            self.y.max,
+            checked_cells("bins", self.y.bins, refine)?,
+        )?;
+        let mut w = Vec::with_capacity(checked_cells("cells", fx.bins, fy.bins)?);
         for i in 0..fx.bins {
             for j in 0..fy.bins {
                 w.push(self.raw(fx.center(i), fy.center(j)));
@@ -405,7 +414,7 @@ impl GaussianKde2d {
     pub fn tabulate(&self, x: BinAxis, y: BinAxis) -> Result<TabulatedPdf2d> {
         x.validate()?;
         y.validate()?;
-        let mut w = Vec::with_capacity(x.bins * y.bins);
+        let mut w = Vec::with_capacity(checked_cells("cells", x.bins, y.bins)?);
         for i in 0..x.bins {
             for j in 0..y.bins {
                 w.push(self.density(x.center(i), y.center(j)));
