@@ -41,6 +41,27 @@ const TETS: [[u8; 4]; 6] = [
     [0, 4, 6, 7],
 ];
 
+/// Slot (0..19) of the cube edge from corner `lo` to corner `hi ⊇ lo` (index `lo·8 + hi`).
+/// Every edge of a Kuhn tetrahedron joins a corner to a superset corner; there are 19 such
+/// pairs (12 cube edges, 6 face diagonals, 1 body diagonal).
+const EDGE_SLOT: [u8; 64] = {
+    let mut t = [u8::MAX; 64];
+    let mut n = 0u8;
+    let mut lo = 0usize;
+    while lo < 8 {
+        let mut hi = lo + 1;
+        while hi < 8 {
+            if hi & lo == lo {
+                t[lo * 8 + hi] = n;
+                n += 1;
+            }
+            hi += 1;
+        }
+        lo += 1;
+    }
+    t
+};
+
 #[inline]
 fn corner_vec(c: u8) -> Vector3<f64> {
     Vector3::new(
@@ -125,70 +146,112 @@ pub(crate) fn walk<S: Sink>(spec: &GridSpec, values: &[f64], sink: &mut S) {
     for (c, o) in off.iter_mut().enumerate() {
         *o = (c & 1) + sy * ((c >> 1) & 1) + sz * ((c >> 2) & 1);
     }
+    // Inside bits of every node row, 64 nodes per word: a cell row is scanned with a few
+    // word operations and only cells with mixed corner signs are visited.
+    let words = nx.div_ceil(64);
+    let mut bits = vec![0u64; words * ny * nz];
+    for (r, row) in values.chunks_exact(nx).enumerate() {
+        for (i, &v) in row.iter().enumerate() {
+            bits[r * words + i / 64] |= u64::from(v < 0.0) << (i % 64);
+        }
+    }
+    let mut any = vec![0u64; words];
+    let mut all = vec![0u64; words];
     for k in 0..nz - 1 {
         sink.begin_layer(k);
         for j in 0..ny - 1 {
-            for i in 0..nx - 1 {
-                let b = i + sy * j + sz * k;
-                let mut phi = [0.0; 8];
-                let mut cmask = 0u8;
-                for c in 0..8 {
-                    let v = values[b + off[c]];
-                    phi[c] = v;
-                    cmask |= u8::from(v < 0.0) << c;
+            let rows = [
+                j + ny * k,
+                j + 1 + ny * k,
+                j + ny * (k + 1),
+                j + 1 + ny * (k + 1),
+            ];
+            for w in 0..words {
+                let r = rows.map(|r| bits[r * words + w]);
+                any[w] = r[0] | r[1] | r[2] | r[3];
+                all[w] = r[0] & r[1] & r[2] & r[3];
+            }
+            for w in 0..words {
+                // Cell i uses nodes i and i+1: combine each word with its right neighbour.
+                let next_any = if w + 1 < words { any[w + 1] << 63 } else { 0 };
+                let next_all = if w + 1 < words { all[w + 1] << 63 } else { 0 };
+                let some_in = any[w] | (any[w] >> 1) | next_any;
+                let all_in = all[w] & ((all[w] >> 1) | next_all);
+                let mut mixed = some_in & !all_in;
+                // Keep cells 0..nx-1 only.
+                let first = w * 64;
+                if first + 64 > nx - 1 {
+                    let valid = (nx - 1).saturating_sub(first);
+                    mixed &= if valid >= 64 {
+                        u64::MAX
+                    } else {
+                        (1u64 << valid) - 1
+                    };
                 }
-                if cmask == 0 || cmask == 255 {
-                    continue;
-                }
-                let base = spec.node(i, j, k);
-                let mut cache: [Option<S::V>; 64] = [None; 64];
-                for (t, tet) in TETS.iter().enumerate() {
-                    let mut m = 0usize;
-                    for (v, &c) in tet.iter().enumerate() {
-                        m |= usize::from((cmask >> c) & 1) << v;
+                while mixed != 0 {
+                    let i = first + mixed.trailing_zeros() as usize;
+                    mixed &= mixed - 1;
+                    let b = i + sy * j + sz * k;
+                    let mut phi = [0.0; 8];
+                    let mut cmask = 0u8;
+                    for c in 0..8 {
+                        let v = values[b + off[c]];
+                        phi[c] = v;
+                        cmask |= u8::from(v < 0.0) << c;
                     }
-                    if m == 0 || m == 15 {
+                    if cmask == 0 || cmask == 255 {
                         continue;
                     }
-                    for &(tri, used) in &tab.tris[t * 16 + m] {
-                        if !used {
+                    let base = spec.node(i, j, k);
+                    let mut cache: [Option<S::V>; 19] = [None; 19];
+                    for (t, tet) in TETS.iter().enumerate() {
+                        let mut m = 0usize;
+                        for (v, &c) in tet.iter().enumerate() {
+                            m |= usize::from((cmask >> c) & 1) << v;
+                        }
+                        if m == 0 || m == 15 {
                             continue;
                         }
-                        let mut handles = [None; 3];
-                        for (slot, &[a, bb]) in tri.iter().enumerate() {
-                            let (lo, hi) = if a < bb { (a, bb) } else { (bb, a) };
-                            let key = (lo as usize) * 8 + hi as usize;
-                            let hnd = match cache[key] {
-                                Some(v) => v,
-                                None => {
-                                    let fa = if phi[lo as usize] < 0.0 {
-                                        phi[lo as usize]
-                                    } else {
-                                        phi[lo as usize].max(delta)
-                                    };
-                                    let fb = if phi[hi as usize] < 0.0 {
-                                        phi[hi as usize]
-                                    } else {
-                                        phi[hi as usize].max(delta)
-                                    };
-                                    let tpar = fa / (fa - fb);
-                                    let d = hi ^ lo;
-                                    let p = base + h * (corner_vec(lo) + tpar * corner_vec(d));
-                                    let v = sink.vertex(
-                                        i + (lo & 1) as usize,
-                                        j + ((lo >> 1) & 1) as usize,
-                                        k + ((lo >> 2) & 1) as usize,
-                                        d,
-                                        p,
-                                    );
-                                    cache[key] = Some(v);
-                                    v
-                                }
-                            };
-                            handles[slot] = Some(hnd);
-                        }
-                        if let [Some(x), Some(y), Some(z)] = handles {
-                            sink.triangle([x, y, z]);
+                        for &(tri, used) in &tab.tris[t * 16 + m] {
+                            if !used {
+                                continue;
+                            }
+                            let mut handles = [None; 3];
+                            for (slot, &[a, bb]) in tri.iter().enumerate() {
+                                let (lo, hi) = if a < bb { (a, bb) } else { (bb, a) };
+                                let key = EDGE_SLOT[(lo as usize) * 8 + hi as usize] as usize;
+                                let hnd = match cache[key] {
+                                    Some(v) => v,
+                                    None => {
+                                        let fa = if phi[lo as usize] < 0.0 {
+                                            phi[lo as usize]
+                                        } else {
+                                            phi[lo as usize].max(delta)
+                                        };
+                                        let fb = if phi[hi as usize] < 0.0 {
+                                            phi[hi as usize]
+                                        } else {
+                                            phi[hi as usize].max(delta)
+                                        };
+                                        let tpar = fa / (fa - fb);
+                                        let d = hi ^ lo;
+                                        let p = base + h * (corner_vec(lo) + tpar * corner_vec(d));
+                                        let v = sink.vertex(
+                                            i + (lo & 1) as usize,
+                                            j + ((lo >> 1) & 1) as usize,
+                                            k + ((lo >> 2) & 1) as usize,
+                                            d,
+                                            p,
+                                        );
+                                        cache[key] = Some(v);
+                                        v
+                                    }
+                                };
+                                handles[slot] = Some(hnd);
+                            }
+                            if let [Some(x), Some(y), Some(z)] = handles {
+                                sink.triangle([x, y, z]);
+                            }
                         }
                     }
                 }
@@ -346,6 +409,23 @@ mod tests {
             m.vertices().len() as i64 - e as i64 + m.triangles().len() as i64,
             2
         );
+    }
+
+    #[test]
+    fn rows_longer_than_one_bit_word_are_scanned() {
+        // 130 nodes along x: three 64-bit words per row, cells across word boundaries.
+        let spec = GridSpec {
+            dims: [130, 23, 23],
+            origin: Point3::new(-3.2, -0.55, -0.55),
+            spacing: 0.05,
+        };
+        let e = crate::shapes::Ellipsoid::new(Vector3::new(3.0, 0.4, 0.4)).expect("e");
+        let g = Grid::from_shape(spec, &e, &Isometry3::identity()).expect("grid");
+        let m = g.marching_cubes();
+        check_closed(&m);
+        let exact = 4.0 / 3.0 * std::f64::consts::PI * 3.0 * 0.16;
+        assert!((m.signed_volume() / exact - 1.0).abs() < 0.01);
+        approx::assert_relative_eq!(g.volume(), m.signed_volume(), max_relative = 1e-9);
     }
 
     #[test]
