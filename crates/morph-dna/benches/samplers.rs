@@ -33,7 +33,7 @@ fn samplers(c: &mut Criterion) {
     let hist = Histogram2d::new(&xs, &ys, (50, 50), None, None).expect("valid histogram");
     let pdf = BicubicPdf::from_histogram(&hist, 8).expect("valid pdf");
     let table = pdf.tabulate(8).expect("valid table");
-    let inverse = InverseCdfSampler2d::new(&table);
+    let inverse = InverseCdfSampler2d::new(&table).expect("valid table");
     let env = EnvelopeRejection2d::new(pdf.clone()).expect("bounded pdf");
     let ar = AcceptanceRejection2d::new(pdf).expect("bounded pdf");
     let kde = GaussianKde2d::fit(&xs, &ys, Bandwidth::Scott).expect("valid kde");

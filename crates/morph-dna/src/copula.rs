@@ -20,7 +20,6 @@
 
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
-use serde::{Deserialize, Serialize};
 
 use crate::correlation::{CorrelationMatrix, CorrelationMethod};
 use crate::error::{Error, Result};
@@ -28,7 +27,7 @@ use crate::stats::{average_ranks, constant_value, normal_cdf, normal_quantile, p
 use crate::table::{Descriptor, DnaTable};
 
 /// Gaussian copula with empirical marginals, fitted to a [`DnaTable`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct GaussianCopula {
     descriptors: Vec<Descriptor>,
     /// Sorted values per descriptor.

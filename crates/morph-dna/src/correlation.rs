@@ -44,7 +44,11 @@ impl CorrelationMatrix {
     /// Entry `(i, j)` by position, `None` out of range.
     pub fn at(&self, i: usize, j: usize) -> Option<f64> {
         let k = self.len();
-        (i < k && j < k).then(|| self.values[i * k + j])
+        if i < k && j < k {
+            self.values.get(i * k + j).copied()
+        } else {
+            None
+        }
     }
 
     /// Entry between two descriptors, `None` if either is absent.
@@ -211,6 +215,13 @@ mod tests {
         )
         .expect("ok");
         assert_eq!(small.max_abs_difference(&p), Err(Error::DescriptorMismatch));
+        let mut edited = small.clone();
+        edited.values.truncate(3);
+        assert_eq!(edited.at(1, 1), None);
+        assert_eq!(
+            edited.max_abs_difference(&small),
+            Err(Error::DescriptorMismatch)
+        );
     }
 
     #[test]

@@ -151,19 +151,60 @@ impl GradingCurve {
         })
     }
 
+    /// Re-checks a curve whose public fields may have been edited: equal,
+    /// non-zero lengths, positive increasing diameters, non-decreasing
+    /// percentages in [0, 100].
+    ///
+    /// # Errors
+    /// [`Error::TooFewSamples`], [`Error::LengthMismatch`],
+    /// [`Error::NonPositive`], [`Error::InvalidParameter`].
+    pub fn validate(&self) -> Result<()> {
+        crate::stats::check_len(&self.diameters, 1)?;
+        if self.diameters.len() != self.passing_percent.len() {
+            return Err(Error::LengthMismatch {
+                left: self.diameters.len(),
+                right: self.passing_percent.len(),
+            });
+        }
+        check_positive("diameter", &self.diameters)?;
+        check_sample(&self.passing_percent)?;
+        if self.diameters.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(Error::InvalidParameter {
+                name: "diameters",
+                value: f64::NAN,
+                reason: "must be strictly increasing",
+            });
+        }
+        if self.passing_percent.windows(2).any(|w| w[1] < w[0])
+            || self
+                .passing_percent
+                .iter()
+                .any(|p| !(0.0..=100.0).contains(p))
+        {
+            return Err(Error::InvalidParameter {
+                name: "passing_percent",
+                value: f64::NAN,
+                reason: "must be non-decreasing within [0, 100]",
+            });
+        }
+        Ok(())
+    }
+
     /// Passing percentage at `d` (the step curve: share of grains ≤ d).
     pub fn passing_at(&self, d: f64) -> f64 {
         match self.diameters.partition_point(|x| *x <= d) {
             0 => 0.0,
-            k => self.passing_percent[k - 1],
+            k => self.passing_percent.get(k - 1).copied().unwrap_or(100.0),
         }
     }
 
     /// Diameter `D_p` at `percent` passing, `0 < percent ≤ 100`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for a percentage outside (0, 100].
+    /// [`Error::InvalidParameter`] for a percentage outside (0, 100], and
+    /// [`GradingCurve::validate`]'s errors.
     pub fn diameter_at(&self, percent: f64, interpolation: GradingInterpolation) -> Result<f64> {
+        self.validate()?;
         if !(percent > 0.0 && percent <= 100.0) {
             return Err(Error::InvalidParameter {
                 name: "percent",
@@ -188,8 +229,8 @@ impl GradingCurve {
     /// D10, D30, D60, Cu and Cc (both variants).
     ///
     /// # Errors
-    /// None for a curve built by this module; the `Result` is
-    /// [`GradingCurve::diameter_at`]'s.
+    /// [`GradingCurve::validate`]'s errors (none for a curve built by this
+    /// module).
     pub fn coefficients(&self, interpolation: GradingInterpolation) -> Result<GradingCoefficients> {
         let d10 = self.diameter_at(10.0, interpolation)?;
         let d30 = self.diameter_at(30.0, interpolation)?;
@@ -279,6 +320,31 @@ mod tests {
         assert!(matches!(
             GradingCurve::from_weighted(&[1.0], &[1.0, 2.0]),
             Err(Error::LengthMismatch { .. })
+        ));
+        let edited = GradingCurve {
+            diameters: vec![],
+            passing_percent: vec![],
+        };
+        assert!(matches!(
+            edited.coefficients(Linear),
+            Err(Error::TooFewSamples { .. })
+        ));
+        let edited = GradingCurve {
+            diameters: vec![1.0, 2.0],
+            passing_percent: vec![100.0],
+        };
+        assert!(matches!(
+            edited.diameter_at(50.0, Linear),
+            Err(Error::LengthMismatch { .. })
+        ));
+        assert_relative_eq!(edited.passing_at(5.0), 100.0);
+        let edited = GradingCurve {
+            diameters: vec![2.0, 1.0],
+            passing_percent: vec![50.0, 100.0],
+        };
+        assert!(matches!(
+            edited.diameter_at(50.0, Linear),
+            Err(Error::InvalidParameter { .. })
         ));
         // A single grain is a valid (degenerate) curve: every D_p is its diameter.
         let one = GradingCurve::from_diameters(&[2.0], GradingWeight::Volume).expect("ok");

@@ -173,9 +173,33 @@ impl Histogram1d {
 
     /// Probability density per bin, `count / (total · width)`, normalised over
     /// the samples inside the range.
+    ///
+    /// A histogram whose public fields were edited to hold no count gives
+    /// zeros rather than NaN.
     pub fn density(&self) -> Vec<f64> {
-        let norm = 1.0 / (self.total() as f64 * self.axis.width());
+        let total = self.total() as f64 * self.axis.width();
+        let norm = if total > 0.0 { 1.0 / total } else { 0.0 };
         self.counts.iter().map(|c| *c as f64 * norm).collect()
+    }
+
+    /// Re-checks a histogram whose public fields may have been edited.
+    ///
+    /// # Errors
+    /// Axis errors, [`Error::RaggedTable`], [`Error::EmptyHistogram`].
+    pub fn validate(&self) -> Result<()> {
+        self.axis.validate()?;
+        if self.counts.len() != self.axis.bins {
+            return Err(Error::RaggedTable {
+                what: "histogram",
+                index: 0,
+                expected: self.axis.bins,
+                found: self.counts.len(),
+            });
+        }
+        if self.total() == 0 {
+            return Err(Error::EmptyHistogram);
+        }
+        Ok(())
     }
 }
 
@@ -251,9 +275,36 @@ impl Histogram2d {
     }
 
     /// Density per cell, `count / (total · wx · wy)`, in the layout of `counts`.
+    ///
+    /// A histogram whose public fields were edited to hold no count gives
+    /// zeros rather than NaN.
     pub fn density(&self) -> Vec<f64> {
-        let norm = 1.0 / (self.total() as f64 * self.x.width() * self.y.width());
+        let total = self.total() as f64 * self.x.width() * self.y.width();
+        let norm = if total > 0.0 { 1.0 / total } else { 0.0 };
         self.counts.iter().map(|c| *c as f64 * norm).collect()
+    }
+
+    /// Re-checks a histogram whose public fields may have been edited.
+    ///
+    /// # Errors
+    /// Axis errors, [`Error::CountTooLarge`], [`Error::RaggedTable`],
+    /// [`Error::EmptyHistogram`].
+    pub fn validate(&self) -> Result<()> {
+        self.x.validate()?;
+        self.y.validate()?;
+        let n = checked_cells("cells", self.x.bins, self.y.bins)?;
+        if self.counts.len() != n {
+            return Err(Error::RaggedTable {
+                what: "histogram",
+                index: 0,
+                expected: n,
+                found: self.counts.len(),
+            });
+        }
+        if self.total() == 0 {
+            return Err(Error::EmptyHistogram);
+        }
+        Ok(())
     }
 }
 
@@ -308,6 +359,13 @@ mod tests {
             Err(Error::CountTooLarge { .. })
         ));
         let p = crate::pdf::BicubicPdf::from_histogram(&h, 2).expect("ok");
+        let mut emptied = h.clone();
+        emptied.counts.iter_mut().for_each(|c| *c = 0);
+        assert!(emptied.density().iter().all(|d| d.to_bits() == 0));
+        assert_eq!(
+            crate::pdf::BicubicPdf::from_histogram(&emptied, 2),
+            Err(Error::EmptyHistogram)
+        );
         assert!(matches!(
             p.tabulate(1 << 13),
             Err(Error::CountTooLarge { .. })

@@ -46,7 +46,7 @@
 //! let (x, y) = (table.column(Descriptor::AspectRatio)?, table.column(Descriptor::MinPrincipalDimension)?);
 //! let hist = Histogram2d::new(x, y, (4, 4), None, None)?;
 //! let pdf = BicubicPdf::from_histogram(&hist, 8)?;
-//! let sampler = InverseCdfSampler2d::new(&pdf.tabulate(8)?);
+//! let sampler = InverseCdfSampler2d::new(&pdf.tabulate(8)?)?;
 //! let mut rng = rand::rngs::StdRng::seed_from_u64(42);
 //! let (ar, s) = sampler.sample(&mut rng);
 //! assert!((0.5..=0.9).contains(&ar) && (1.0e-3..=1.9e-3).contains(&s));

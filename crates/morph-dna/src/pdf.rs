@@ -60,6 +60,15 @@ impl TabulatedPdf2d {
         Ok(Self { x, y, density })
     }
 
+    /// Re-checks a table whose public fields may have been edited: valid
+    /// axes, one finite non-negative density per cell, positive mass.
+    ///
+    /// # Errors
+    /// As [`TabulatedPdf2d::new`].
+    pub fn validate(&self) -> Result<()> {
+        Self::new(self.x, self.y, self.density.clone()).map(|_| ())
+    }
+
     /// The histogram itself as a density (constant in each bin).
     ///
     /// # Errors
@@ -72,7 +81,11 @@ impl TabulatedPdf2d {
     /// Density at `(x, y)`, zero outside the rectangle.
     pub fn density_at(&self, x: f64, y: f64) -> f64 {
         match (self.x.bin_of(x), self.y.bin_of(y)) {
-            (Some(i), Some(j)) => self.density[i * self.y.bins + j],
+            (Some(i), Some(j)) => self
+                .density
+                .get(i * self.y.bins + j)
+                .copied()
+                .unwrap_or(0.0),
             _ => 0.0,
         }
     }
@@ -114,7 +127,7 @@ const CATMULL_ROM_ABS_SUM: f64 = 1.25;
 ///   clamped to zero, and the result is renormalised to unit mass over the
 ///   histogram rectangle by the midpoint rule on `refine × refine` points per
 ///   bin (the normaliser's quadrature error is O((w/refine)²)).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct BicubicPdf {
     x: BinAxis,
     y: BinAxis,
@@ -128,6 +141,7 @@ impl BicubicPdf {
     /// bin and axis (8 is plenty).
     ///
     /// # Errors
+    /// Errors of [`Histogram2d::validate`], [`Error::CountTooLarge`],
     /// [`Error::CountTooSmall`] if `refine = 0`, [`Error::ZeroMass`] if the
     /// clamped interpolant has no mass (cannot happen for a non-empty
     /// histogram, kept as a guard).
@@ -139,6 +153,7 @@ impl BicubicPdf {
                 value: 0,
             });
         }
+        h.validate()?;
         let nodes = h.density();
         let max_node = nodes.iter().fold(0.0, |m: f64, v| m.max(*v));
         let mut pdf = Self {
@@ -298,7 +313,7 @@ pub enum Bandwidth {
 /// `H = h² Σ` (Σ the sample covariance, divisor n − 1), the smoother
 /// alternative to [`BicubicPdf`]: no binning, no negative lobes, exact
 /// sampling by the smoothed bootstrap (pick a datum, add kernel noise).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct GaussianKde2d {
     xs: Vec<f64>,
     ys: Vec<f64>,

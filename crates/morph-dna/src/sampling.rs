@@ -21,6 +21,13 @@ pub trait Density2d {
     fn density(&self, x: f64, y: f64) -> f64;
     /// An upper bound of [`Density2d::density`] on the support.
     fn upper_bound(&self) -> f64;
+    /// Checks the density's own invariants (default: none to check).
+    ///
+    /// # Errors
+    /// Whatever the implementation finds.
+    fn validate(&self) -> Result<()> {
+        Ok(())
+    }
 }
 
 impl Density2d for BicubicPdf {
@@ -46,6 +53,9 @@ impl Density2d for TabulatedPdf2d {
     fn upper_bound(&self) -> f64 {
         self.max_density()
     }
+    fn validate(&self) -> Result<()> {
+        TabulatedPdf2d::validate(self)
+    }
 }
 
 /// The seed's Monte Carlo sampler (Medina 2018, §2.2): propose `(x, y)`
@@ -65,9 +75,11 @@ impl<D: Density2d> AcceptanceRejection2d<D> {
     /// Wraps a density.
     ///
     /// # Errors
-    /// [`Error::InvalidRange`] for an empty or non-finite support,
+    /// [`Density2d::validate`]'s errors, [`Error::InvalidRange`] for an
+    /// empty or non-finite support,
     /// [`Error::InvalidParameter`] for a bound that is not finite and positive.
     pub fn new(pdf: D) -> Result<Self> {
+        pdf.validate()?;
         let (x, y) = pdf.support();
         for (a, b) in [x, y] {
             if !(a.is_finite() && b.is_finite() && a < b) {
@@ -363,7 +375,11 @@ pub struct InverseCdfSampler2d {
 
 impl InverseCdfSampler2d {
     /// Precomputes the marginal and conditional CDFs (O(cells)).
-    pub fn new(pdf: &TabulatedPdf2d) -> Self {
+    ///
+    /// # Errors
+    /// Those of [`TabulatedPdf2d::validate`] (the table's fields are public).
+    pub fn new(pdf: &TabulatedPdf2d) -> Result<Self> {
+        pdf.validate()?;
         let (nx, ny) = (pdf.x.bins, pdf.y.bins);
         let mut marginal = Vec::with_capacity(nx);
         let mut cond_cdf = Vec::with_capacity(nx * (ny + 1));
@@ -380,14 +396,14 @@ impl InverseCdfSampler2d {
                 cond_guide.extend(std::iter::repeat_n(0, ny));
             }
         }
-        Self {
+        Ok(Self {
             x: pdf.x,
             y: pdf.y,
             marginal: GuidedCdf::new(&marginal),
             cond_cdf,
             cond_guide,
             has_mass,
-        }
+        })
     }
 
     /// `y` drawn from the conditional CDF of column `i` (which has mass).
@@ -491,7 +507,7 @@ mod tests {
         let y = BinAxis::new(0.0, 2.0, 2).expect("ok");
         // Column 0: all mass in y ∈ [1, 2); column 1: no mass.
         let t = TabulatedPdf2d::new(x, y, vec![0.0, 1.0, 0.0, 0.0]).expect("ok");
-        let s = InverseCdfSampler2d::new(&t);
+        let s = InverseCdfSampler2d::new(&t).expect("valid");
         let seed = 7;
         #[expect(clippy::print_stdout, reason = "seeded tests print their seed")]
         {
@@ -509,6 +525,23 @@ mod tests {
         assert!(matches!(
             s.sample_y_given_x(1.5, &mut rng),
             Err(Error::ZeroMass { .. })
+        ));
+        // Public fields edited into an inconsistent state are rejected.
+        let mut bad = t.clone();
+        bad.y.bins = 0;
+        assert!(matches!(
+            InverseCdfSampler2d::new(&bad),
+            Err(Error::CountTooSmall { .. })
+        ));
+        let mut bad = t.clone();
+        bad.density.pop();
+        assert!(matches!(
+            InverseCdfSampler2d::new(&bad),
+            Err(Error::RaggedTable { .. })
+        ));
+        assert!(matches!(
+            AcceptanceRejection2d::new(bad),
+            Err(Error::RaggedTable { .. })
         ));
         assert!(matches!(
             s.sample_y_given_x(2.5, &mut rng),

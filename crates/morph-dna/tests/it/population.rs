@@ -143,7 +143,8 @@ fn seeded_sampling_is_deterministic() {
     let x = [0.1, 0.5, 0.9, 0.3, 0.35, 0.8];
     let y = [1.0, 1.5, 1.9, 1.2, 1.1, 1.7];
     let h = Histogram2d::new(&x, &y, (3, 3), None, None).expect("valid");
-    let s = InverseCdfSampler2d::new(&TabulatedPdf2d::from_histogram(&h).expect("valid"));
+    let s = InverseCdfSampler2d::new(&TabulatedPdf2d::from_histogram(&h).expect("valid"))
+        .expect("valid");
     let draw = |seed: u64| {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         (0..100)
@@ -201,7 +202,7 @@ proptest! {
             .expect("inside range");
         let bicubic = morph_dna::BicubicPdf::from_histogram(&h, 4).expect("valid");
         let table = bicubic.tabulate(4).expect("valid");
-        let inv = InverseCdfSampler2d::new(&table);
+        let inv = InverseCdfSampler2d::new(&table).expect("valid");
         let ar = morph_dna::AcceptanceRejection2d::new(bicubic).expect("bounded");
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         for _ in 0..20 {

@@ -87,12 +87,14 @@ fn every_sampler_reproduces_a_correlated_bivariate_normal() {
     }
 
     // Exact inverse CDF on the bicubic PDF tabulated 8× finer.
-    let inverse = InverseCdfSampler2d::new(&bicubic.tabulate(8).expect("valid table"));
+    let inverse =
+        InverseCdfSampler2d::new(&bicubic.tabulate(8).expect("valid table")).expect("valid");
     let draws: Vec<_> = (0..N_DRAWS).map(|_| inverse.sample(&mut rng)).collect();
     check("inverse CDF (bicubic, 400 x 400)", &draws);
 
     // Exact inverse CDF on the raw histogram (piecewise constant).
-    let raw = InverseCdfSampler2d::new(&TabulatedPdf2d::from_histogram(&hist).expect("valid"));
+    let raw = InverseCdfSampler2d::new(&TabulatedPdf2d::from_histogram(&hist).expect("valid"))
+        .expect("valid");
     let draws: Vec<_> = (0..N_DRAWS).map(|_| raw.sample(&mut rng)).collect();
     check("inverse CDF (histogram, 50 x 50)", &draws);
 
@@ -184,7 +186,8 @@ fn samplers_reproduce_a_density_with_mass_at_the_edges() {
         .expect("valid histogram");
     let bicubic = BicubicPdf::from_histogram(&hist, 8).expect("valid pdf");
     let ar = AcceptanceRejection2d::new(bicubic.clone()).expect("bounded");
-    let inverse = InverseCdfSampler2d::new(&bicubic.tabulate(8).expect("valid table"));
+    let inverse =
+        InverseCdfSampler2d::new(&bicubic.tabulate(8).expect("valid table")).expect("valid");
     let env = EnvelopeRejection2d::new(bicubic.clone()).expect("bounded");
     let cdf = |t: f64| 0.5 * (t * t + t);
     // Pearson correlation of f = x + y on the unit square: −1/11.
