@@ -6,7 +6,10 @@
 use packer_quadtree::{Domain, GaParams, Grading, HaloMode, PackParams, optimise_porosity};
 
 fn main() -> Result<(), packer_quadtree::Error> {
-    let domain = Domain::Rectangle { width: 20.0, height: 20.0 };
+    let domain = Domain::Rectangle {
+        width: 20.0,
+        height: 20.0,
+    };
     let tests = [
         ("AP-1", Grading::Constant { diameter: 1.2 }),
         ("AP-2", Grading::Uniform { min: 1.2, max: 1.3 }),
@@ -14,7 +17,16 @@ fn main() -> Result<(), packer_quadtree::Error> {
         ("AP-4", Grading::Uniform { min: 1.2, max: 4.8 }),
         ("AP-5", Grading::pinto_ap5()),
     ];
-    for (label, params) in [("contact halo", PackParams::default()), ("seed halo d_max", PackParams { halo: HaloMode::MaxDiameter, ..PackParams::default() })] {
+    for (label, params) in [
+        ("contact halo", PackParams::default()),
+        (
+            "seed halo d_max",
+            PackParams {
+                halo: HaloMode::MaxDiameter,
+                ..PackParams::default()
+            },
+        ),
+    ] {
         for (name, g) in &tests {
             let t = std::time::Instant::now();
             let r = optimise_porosity(&domain, g, &params, &GaParams::default(), 1)?;
