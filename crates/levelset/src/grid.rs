@@ -277,7 +277,7 @@ impl Grid {
 
     /// Trilinear value at any point. Outside the grid box the value at the nearest box
     /// point plus the distance to the box is returned (continuous, never smaller than the
-    /// true distance for a grain inside the box).
+    /// true distance for a grain inside the box). A non-finite point gives NaN.
     pub fn value(&self, p: &Point3<f64>) -> f64 {
         let lo = self.spec.origin;
         let hi = self.spec.max_corner();
@@ -513,6 +513,24 @@ mod tests {
             epsilon = 1e-12
         );
         assert!(g.try_value(&p).is_none());
+    }
+
+    #[test]
+    fn covering_spec_contains_the_box_with_margin() {
+        let lo = Point3::new(-1.0, -0.5, 0.0);
+        let hi = Point3::new(1.0, 0.5, 0.3);
+        let s = GridSpec::covering(lo, hi, 0.1, 0.2).expect("spec");
+        let top = s.max_corner();
+        for a in 0..3 {
+            assert!(s.origin[a] <= lo[a] - 0.2 + 1e-12);
+            assert!(top[a] >= hi[a] + 0.2 - 1e-12);
+            assert!(s.dims[a] >= 3);
+        }
+        assert!(GridSpec::covering(lo, hi, 0.0, 0.2).is_err());
+        assert!(GridSpec::covering(hi, lo, 0.1, 0.2).is_err());
+        assert!(GridSpec::covering(lo, hi, 0.1, f64::NAN).is_err());
+        assert!(GridSpec::cube(2, -1.0, 1.0).is_err());
+        assert!(GridSpec::cube(5, 1.0, -1.0).is_err());
     }
 
     #[test]

@@ -147,7 +147,7 @@ impl Grid {
     /// inside the grid box; the surface should be too (parts outside the box are clipped).
     ///
     /// Calls: `6·(face_cells+1)²` with the default cube map (6534 for `face_cells = 32`),
-    /// or one per node with [`DirectionTable::Exact`] (+1 for a node at the centre).
+    /// or exactly one per node with [`DirectionTable::Exact`].
     ///
     /// # Errors
     /// Invalid spec or params, a radius that is not finite and positive
