@@ -32,6 +32,19 @@ impl Grid {
     }
 }
 
+/// `min` without NaN handling (compiles to one `minsd`); the sweeps never see NaN
+/// (values are finite or +∞), and `f64::min`'s NaN checks cost ≈40 % of the sweep time.
+#[inline(always)]
+fn fmin(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
+}
+
+/// `max` without NaN handling, see [`fmin`].
+#[inline(always)]
+fn fmax(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
 /// Redistances `values` in place. With `upper_bound`, the current magnitudes are known to be
 /// upper bounds of the distance (e.g. the radial distance of a star-shaped surface) and
 /// are used as the initial guess instead of +∞, which shortens the sweeps.
@@ -55,6 +68,17 @@ pub(crate) fn redistance(spec: &GridSpec, values: &mut [f64], upper_bound: bool)
                 let v = values[g];
                 let inside = v < 0.0;
                 let idx = [i, j, k];
+                // Fast path: interior nodes whose six neighbours share their sign.
+                if i > 0 && j > 0 && k > 0 && i + 1 < nx && j + 1 < ny && k + 1 < nz {
+                    let same = [g - 1, g + 1, g - nx, g + nx, g - nx * ny, g + nx * ny]
+                        .iter()
+                        .all(|&q| (values[q] < 0.0) == inside);
+                    if same {
+                        u[p] = if upper_bound { v.abs() } else { f64::INFINITY };
+                        fixed[p] = false;
+                        continue;
+                    }
+                }
                 let mut cap = f64::INFINITY;
                 let mut grad2 = 0.0;
                 for a in 0..3 {
@@ -122,13 +146,13 @@ pub(crate) fn redistance(spec: &GridSpec, values: &mut [f64], upper_bound: bool)
                     let j = if fy { jp } else { ny - 1 - jp } + 1;
                     let i = if fx { ip } else { nx - 1 - ip } + 1;
                     let p = i + sy * j + sz * k;
-                    let a = u[p - 1].min(u[p + 1]);
-                    let b = u[p - sy].min(u[p + sy]);
-                    let c = u[p - sz].min(u[p + sz]);
+                    let a = fmin(u[p - 1], u[p + 1]);
+                    let b = fmin(u[p - sy], u[p + sy]);
+                    let c = fmin(u[p - sz], u[p + sz]);
                     // Sorting network: lo ≤ mid ≤ hi.
-                    let (s0, s1) = (a.min(b), a.max(b));
-                    let (lo, t) = (s0.min(c), s0.max(c));
-                    let (mid, hi) = (s1.min(t), s1.max(t));
+                    let (s0, s1) = (fmin(a, b), fmax(a, b));
+                    let (lo, t) = (fmin(s0, c), fmax(s0, c));
+                    let (mid, hi) = (fmin(s1, t), fmax(s1, t));
                     // Branch-free Godunov update with a single square root: pick the
                     // case by comparisons first (x₂ ≤ hi ⟺ D₂ ≤ (2·hi − lo − mid)²), then
                     // take one root. Unused expressions may be NaN/∞ and are never selected.
@@ -144,9 +168,9 @@ pub(crate) fn redistance(spec: &GridSpec, values: &mut [f64], upper_bound: bool)
                     } else {
                         (s, d3, 1.0 / 3.0)
                     };
-                    let xr = scale * (lin + disc.max(0.0).sqrt());
+                    let xr = scale * (lin + fmax(disc, 0.0).sqrt());
                     let x = if x1 <= mid { x1 } else { xr };
-                    let new = u[p].min(x);
+                    let new = fmin(u[p], x);
                     u[p] = if fixed[p] { u[p] } else { new };
                 }
             }
