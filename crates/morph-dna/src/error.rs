@@ -279,6 +279,12 @@ pub enum Error {
         /// The parser's message, with its position.
         message: String,
     },
+    /// The level-set library rejected a grid or a construction.
+    #[error("level set: {message}")]
+    LevelSet {
+        /// The level-set error, rendered.
+        message: String,
+    },
     /// Writing to or reading from the caller's stream failed.
     #[error("i/o: {message}")]
     Io {

@@ -22,9 +22,13 @@
 //! * [`compare_populations`]: Medina 2018 Tables 4–5 errors, KS, W1 and
 //!   correlation-matrix differences.
 //!
-//! The per-grain descriptors measured on level-set grids and SH models, and
-//! the radial profiles on the principal-axis mesh, fill these types; they
-//! live beside this population half (issue 5).
+//! * [`measure`]: the per-grain descriptors of a `levelset::Grid` (only
+//!   those asked for are computed), [`measure_star`] for any star-shaped
+//!   radius function (e.g. a spherical-harmonic model), [`measure_table`] for
+//!   a population; [`principal_frame`] (deterministic axis signs) and
+//!   [`radial_profile`] on a [`SphericalMesh`]; [`convex_hull_volume`]
+//!   (Quickhull) for the convexity. Definitions and the roundness corner rule
+//!   are in the [`measure`] module docs.
 //!
 //! # Example
 //!
@@ -85,6 +89,8 @@ pub mod csv;
 pub mod error;
 pub mod grading;
 pub mod histogram;
+pub mod hull;
+pub mod measure;
 pub mod pdf;
 pub mod radial;
 pub mod sampling;
@@ -100,6 +106,11 @@ pub use correlation::{CorrelationMatrix, CorrelationMethod, correlation_matrix};
 pub use error::{CsvErrorKind, Error, Moment, Result};
 pub use grading::{GradingCoefficients, GradingCurve, GradingInterpolation, GradingWeight};
 pub use histogram::{BinAxis, Histogram1d, Histogram2d};
+pub use hull::{convex_hull, convex_hull_volume};
+pub use measure::{
+    CornerAveraging, MeasureParams, PrincipalFrame, max_principal_curvature, measure, measure_star,
+    measure_table, principal_frame, radial_profile,
+};
 pub use pdf::{Bandwidth, BicubicPdf, GaussianKde2d, TabulatedPdf2d};
 pub use radial::{
     NeighbourCorrelation, NeighbourCorrelationSummary, RadialProfiles, SphericalMesh,

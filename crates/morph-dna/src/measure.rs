@@ -1,0 +1,561 @@
+//! Per-grain descriptors measured on a level-set grid, the principal frame of
+//! a grain and its radial profile on the spherical mesh (Medina 2018,
+//! §2.1–2.3; definitions in [`Descriptor`]).
+//!
+//! Only what is asked for is computed: volume-type descriptors need one pass
+//! of exact piecewise-linear integration over the zero level set
+//! (`levelset::Grid::mass_properties`); extents, convexity and roundness
+//! additionally need the marching-cubes surface; roundness needs curvatures
+//! and the inscribed sphere.
+//!
+//! # Design choices the seed leaves open
+//!
+//! * **Principal dimensions** are the full axes of the inertia-equivalent
+//!   ellipsoid (the solid ellipsoid with the grain's principal moments),
+//!   scaled to the grain's volume: exact for ellipsoids, insensitive to
+//!   surface noise. The raw extents along the principal axes are also given
+//!   (`*Extent`), which is what a caliper along those axes would read.
+//! * **3D roundness** follows the level-set definition of Vlahinić et al.
+//!   (2014, *Granular Matter* 16:9–21, doi:10.1007/s10035-013-0460-6), used
+//!   by GSC 1.0 (Jerves et al. 2017): the mean radius of curvature of the
+//!   grain's corners over the radius of its largest inscribed sphere, a 3D
+//!   Wadell (1932) roundness. **Corner rule:** a surface point is a corner
+//!   when its largest principal curvature exceeds that of the inscribed
+//!   sphere, κ₁ > 1/r_ins — it is sharper than the grain's "body". The mean of
+//!   the radii 1/κ₁ over corners is area-weighted (marching-cubes vertex
+//!   areas). Every corner radius is < r_ins, so roundness ∈ (0, 1]; a grain
+//!   with no corner (a sphere in exact arithmetic) has roundness 1.
+//!   Curvatures come from the shape operator `P H P / |∇φ|` of the level set
+//!   (H by second central differences at the nodes, trilinearly
+//!   interpolated), so they resolve radii down to about one grid spacing: a
+//!   sharp edge reads as a radius of order h.
+//! * **Principal frame signs** (eigenvectors are defined up to sign): the
+//!   major and intermediate axes point to the side where the grain's third
+//!   volume moment along them is positive (the "heavier tail"); the minor axis
+//!   completes a right-handed frame. A symmetric grain keeps the
+//!   eigen-solver's deterministic sign.
+//! * **Radial profile**: the radius at a mesh node is the first crossing of
+//!   the zero level set along the ray from the centroid (bisection to 1e-10
+//!   of the grid spacing); this is the grain's radius for star-shaped grains
+//!   and the first boundary crossing otherwise.
+
+use nalgebra::{Matrix3, Point3, SymmetricEigen, Unit, Vector3};
+
+use levelset::{Grid, GridSpec, StarParams};
+
+use crate::error::{Error, Result};
+use crate::hull::convex_hull_volume;
+use crate::radial::SphericalMesh;
+use crate::table::{Descriptor, DnaTable};
+
+fn ls_err(e: levelset::Error) -> Error {
+    Error::LevelSet {
+        message: e.to_string(),
+    }
+}
+
+/// Centroid and principal axes of a grain with deterministic signs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrincipalFrame {
+    /// Centre of volume.
+    pub centroid: Point3<f64>,
+    /// Columns: major, intermediate and minor principal axes (unit,
+    /// right-handed); the major axis has the smallest moment of inertia.
+    pub axes: Matrix3<f64>,
+    /// Principal moments of inertia per unit density, ascending (about the
+    /// major, intermediate and minor axes).
+    pub moments: Vector3<f64>,
+    /// Volume.
+    pub volume: f64,
+    /// Surface area.
+    pub area: f64,
+}
+
+impl PrincipalFrame {
+    /// Full axes `[L, I, S]` of the inertia-equivalent ellipsoid scaled to the
+    /// grain's volume.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if the moments describe a degenerate body.
+    pub fn principal_dimensions(&self) -> Result<[f64; 3]> {
+        let m = self.moments;
+        let v = self.volume;
+        let semi2 = [
+            2.5 / v * (m[1] + m[2] - m[0]),
+            2.5 / v * (m[0] + m[2] - m[1]),
+            2.5 / v * (m[0] + m[1] - m[2]),
+        ];
+        if semi2.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(Error::InvalidParameter {
+                name: "principal moments",
+                value: m[2],
+                reason: "moments of a body with positive extent along every axis",
+            });
+        }
+        let semi = semi2.map(f64::sqrt);
+        let k = (v / (4.0 / 3.0 * std::f64::consts::PI * semi[0] * semi[1] * semi[2])).cbrt();
+        Ok(semi.map(|a| 2.0 * k * a))
+    }
+
+    /// World direction of the mesh direction `(θ, φ)` in this frame (θ from
+    /// the minor axis, φ from the major axis towards the intermediate one).
+    pub fn direction(&self, theta: f64, phi: f64) -> Unit<Vector3<f64>> {
+        let local = Vector3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        );
+        Unit::new_normalize(self.axes * local)
+    }
+}
+
+/// Centroid, principal axes (deterministic signs, see the module docs) and
+/// moments of the grain.
+///
+/// # Errors
+/// [`Error::LevelSet`] if the grid holds no closed surface.
+pub fn principal_frame(grid: &Grid) -> Result<PrincipalFrame> {
+    let mp = grid.mass_properties().map_err(ls_err)?;
+    let eig = SymmetricEigen::new(mp.inertia);
+    let mut idx = [0usize, 1, 2];
+    idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+    let moments = Vector3::new(
+        eig.eigenvalues[idx[0]],
+        eig.eigenvalues[idx[1]],
+        eig.eigenvalues[idx[2]],
+    );
+    let mut e: Vec<Vector3<f64>> = idx
+        .iter()
+        .map(|&i| eig.eigenvectors.column(i).into_owned())
+        .collect();
+    // third moments along the first two axes over the (smoothed) interior
+    let spec = grid.spec();
+    let h = spec.spacing;
+    let [nx, ny, nz] = spec.dims;
+    let mut third = [0.0f64; 2];
+    let c = mp.centroid;
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let phi = grid.at(i, j, k);
+                let w = (0.5 - phi / h).clamp(0.0, 1.0);
+                if w == 0.0 {
+                    continue;
+                }
+                let d = spec.node(i, j, k) - c;
+                for (t, axis) in third.iter_mut().zip(&e) {
+                    *t += w * d.dot(axis).powi(3);
+                }
+            }
+        }
+    }
+    for a in 0..2 {
+        if third[a] < 0.0 {
+            e[a] = -e[a];
+        }
+    }
+    e[2] = e[0].cross(&e[1]);
+    Ok(PrincipalFrame {
+        centroid: c,
+        axes: Matrix3::from_columns(&[e[0], e[1], e[2]]),
+        moments,
+        volume: mp.volume,
+        area: mp.area,
+    })
+}
+
+/// Parameters of [`measure`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MeasureParams {
+    /// Corner rule of the roundness: a surface point is a corner when its
+    /// largest principal curvature exceeds `(1 + corner_margin) / r_ins`.
+    /// The default 0 is the rule of the module docs; a positive margin
+    /// ignores points only slightly sharper than the inscribed sphere.
+    pub corner_margin: f64,
+    /// How the corner radii are averaged.
+    pub averaging: CornerAveraging,
+}
+
+/// How [`Descriptor::Roundness`] averages the radii of curvature of corners.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CornerAveraging {
+    /// Area-weighted mean of the radii `1/κ₁` (Wadell's arithmetic mean).
+    Radius,
+    /// Reciprocal of the area-weighted mean curvature, `1 / ⟨κ₁⟩`: the sharpest
+    /// corners dominate, so an edge sharper than the grid reads as sharper
+    /// than a resolved rounded edge (monotone in the edge radius even below
+    /// the grid spacing). Default.
+    #[default]
+    Curvature,
+}
+
+impl MeasureParams {
+    /// Checks that the margin is finite and non-negative.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`].
+    pub fn validate(&self) -> Result<()> {
+        if !(self.corner_margin.is_finite() && self.corner_margin >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "corner_margin",
+                value: self.corner_margin,
+                reason: "finite and >= 0",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Hessian of φ at node (i, j, k) by second central differences (one-sided
+/// indices clamped at the grid border).
+fn node_hessian(grid: &Grid, i: usize, j: usize, k: usize) -> Matrix3<f64> {
+    let [nx, ny, nz] = grid.dims();
+    let h2 = grid.spacing() * grid.spacing();
+    // clamp to the interior so that every ±1 neighbour exists
+    let (i, j, k) = (i.clamp(1, nx - 2), j.clamp(1, ny - 2), k.clamp(1, nz - 2));
+    let f = |di: isize, dj: isize, dk: isize| {
+        grid.at(
+            i.wrapping_add_signed(di),
+            j.wrapping_add_signed(dj),
+            k.wrapping_add_signed(dk),
+        )
+    };
+    let c = f(0, 0, 0);
+    let xx = (f(1, 0, 0) - 2.0 * c + f(-1, 0, 0)) / h2;
+    let yy = (f(0, 1, 0) - 2.0 * c + f(0, -1, 0)) / h2;
+    let zz = (f(0, 0, 1) - 2.0 * c + f(0, 0, -1)) / h2;
+    let xy = (f(1, 1, 0) - f(1, -1, 0) - f(-1, 1, 0) + f(-1, -1, 0)) / (4.0 * h2);
+    let xz = (f(1, 0, 1) - f(1, 0, -1) - f(-1, 0, 1) + f(-1, 0, -1)) / (4.0 * h2);
+    let yz = (f(0, 1, 1) - f(0, 1, -1) - f(0, -1, 1) + f(0, -1, -1)) / (4.0 * h2);
+    Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
+}
+
+/// Largest principal curvature of the level set through `p` (positive where
+/// the surface is convex), or `None` where the gradient vanishes.
+pub fn max_principal_curvature(grid: &Grid, p: &Point3<f64>) -> Option<f64> {
+    let spec = grid.spec();
+    let h = spec.spacing;
+    let [nx, ny, nz] = spec.dims;
+    let rel = (p - spec.origin) / h;
+    let base = |x: f64, n: usize| -> (usize, f64) {
+        let x = x.clamp(0.0, (n - 1) as f64);
+        let i = (x.floor() as usize).min(n - 2);
+        (i, x - i as f64)
+    };
+    let (i, tx) = base(rel.x, nx);
+    let (j, ty) = base(rel.y, ny);
+    let (k, tz) = base(rel.z, nz);
+    let mut hess = Matrix3::zeros();
+    for (dk, wz) in [(0, 1.0 - tz), (1, tz)] {
+        for (dj, wy) in [(0, 1.0 - ty), (1, ty)] {
+            for (di, wx) in [(0, 1.0 - tx), (1, tx)] {
+                let w = wx * wy * wz;
+                if w > 0.0 {
+                    hess += w * node_hessian(grid, i + di, j + dj, k + dk);
+                }
+            }
+        }
+    }
+    let g = grid.gradient(p);
+    let gn = g.norm();
+    if gn.is_nan() || gn <= 1e-12 {
+        return None;
+    }
+    let n = g / gn;
+    let proj = Matrix3::identity() - n * n.transpose();
+    let shape = proj * hess * proj / gn;
+    let eig = SymmetricEigen::new(shape);
+    // drop the eigenvalue whose eigenvector is the normal
+    let mut best = (0usize, -1.0);
+    for a in 0..3 {
+        let align = eig.eigenvectors.column(a).dot(&n).abs();
+        if align > best.1 {
+            best = (a, align);
+        }
+    }
+    (0..3)
+        .filter(|&a| a != best.0)
+        .map(|a| eig.eigenvalues[a])
+        .reduce(f64::max)
+}
+
+/// The requested descriptors of the grain represented by `grid`, in the order
+/// of `wanted`.
+///
+/// # Errors
+/// [`Error::LevelSet`] for a grid without a closed surface (empty, all
+/// inside, or the surface touching the grid border is closed by the grid
+/// box), [`Error::InvalidParameter`] for invalid params or a degenerate grain.
+pub fn measure(grid: &Grid, wanted: &[Descriptor], params: &MeasureParams) -> Result<Vec<f64>> {
+    params.validate()?;
+    let need_mesh = wanted.iter().any(|d| {
+        matches!(
+            d,
+            Descriptor::MajorExtent
+                | Descriptor::IntermediateExtent
+                | Descriptor::MinorExtent
+                | Descriptor::Convexity
+                | Descriptor::Roundness
+        )
+    });
+    let need_frame = need_mesh
+        || wanted.iter().any(|d| {
+            matches!(
+                d,
+                Descriptor::MajorPrincipalDimension
+                    | Descriptor::IntermediatePrincipalDimension
+                    | Descriptor::MinPrincipalDimension
+                    | Descriptor::AspectRatio
+                    | Descriptor::Elongation
+                    | Descriptor::Flatness
+            )
+        });
+    if grid.values().iter().all(|v| *v < 0.0) {
+        return Err(Error::LevelSet {
+            message: "every node is inside: the grain does not fit in its grid".into(),
+        });
+    }
+    let (volume, area, frame) = if need_frame {
+        let f = principal_frame(grid)?;
+        (f.volume, f.area, Some(f))
+    } else {
+        let mp = grid.mass_properties().map_err(ls_err)?;
+        (mp.volume, mp.area, None)
+    };
+    let dims = match &frame {
+        Some(f)
+            if wanted.iter().any(|d| {
+                matches!(
+                    d,
+                    Descriptor::MajorPrincipalDimension
+                        | Descriptor::IntermediatePrincipalDimension
+                        | Descriptor::MinPrincipalDimension
+                        | Descriptor::AspectRatio
+                        | Descriptor::Elongation
+                        | Descriptor::Flatness
+                )
+            }) =>
+        {
+            Some(f.principal_dimensions()?)
+        }
+        _ => None,
+    };
+    let mesh = if need_mesh {
+        Some(grid.marching_cubes())
+    } else {
+        None
+    };
+    let mut out = Vec::with_capacity(wanted.len());
+    for &d in wanted {
+        let v = match d {
+            Descriptor::Volume => volume,
+            Descriptor::SurfaceArea => area,
+            Descriptor::VolumeSurfaceRatio => volume / area,
+            Descriptor::EquivalentDiameter => (6.0 * volume / std::f64::consts::PI).cbrt(),
+            Descriptor::Sphericity => {
+                std::f64::consts::PI.cbrt() * (6.0 * volume).powf(2.0 / 3.0) / area
+            }
+            Descriptor::MajorPrincipalDimension => dims.map_or(f64::NAN, |x| x[0]),
+            Descriptor::IntermediatePrincipalDimension => dims.map_or(f64::NAN, |x| x[1]),
+            Descriptor::MinPrincipalDimension => dims.map_or(f64::NAN, |x| x[2]),
+            Descriptor::AspectRatio => dims.map_or(f64::NAN, |x| x[2] / x[0]),
+            Descriptor::Elongation => dims.map_or(f64::NAN, |x| x[1] / x[0]),
+            Descriptor::Flatness => dims.map_or(f64::NAN, |x| x[2] / x[1]),
+            Descriptor::MajorExtent | Descriptor::IntermediateExtent | Descriptor::MinorExtent => {
+                let (Some(f), Some(m)) = (&frame, &mesh) else {
+                    unreachable_state()?
+                };
+                let a = match d {
+                    Descriptor::MajorExtent => 0,
+                    Descriptor::IntermediateExtent => 1,
+                    _ => 2,
+                };
+                let axis = f.axes.column(a);
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for p in m.vertices() {
+                    let s = (p - f.centroid).dot(&axis);
+                    lo = lo.min(s);
+                    hi = hi.max(s);
+                }
+                hi - lo
+            }
+            Descriptor::Convexity => {
+                let Some(m) = &mesh else { unreachable_state()? };
+                let hull = convex_hull_volume(m.vertices())?;
+                (volume / hull).min(1.0)
+            }
+            Descriptor::Roundness => {
+                let Some(m) = &mesh else { unreachable_state()? };
+                roundness(grid, m, params)?
+            }
+        };
+        if !v.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "grain",
+                value: v,
+                reason: "a grain whose descriptors are finite (degenerate geometry)",
+            });
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+fn unreachable_state<T>() -> Result<T> {
+    Err(Error::InvalidParameter {
+        name: "internal state",
+        value: f64::NAN,
+        reason: "surface mesh computed whenever a descriptor needs it",
+    })
+}
+
+/// 3D roundness of the module docs.
+fn roundness(grid: &Grid, mesh: &levelset::TriMesh, params: &MeasureParams) -> Result<f64> {
+    let (r_ins, _) = grid.inscribed_sphere().map_err(ls_err)?;
+    if r_ins.is_nan() || r_ins <= 0.0 {
+        return Err(Error::InvalidParameter {
+            name: "inscribed radius",
+            value: r_ins,
+            reason: "a grain with positive inscribed radius",
+        });
+    }
+    let verts = mesh.vertices();
+    let mut weight = vec![0.0; verts.len()];
+    for t in mesh.triangles() {
+        let a = 0.5
+            * (verts[t[1]] - verts[t[0]])
+                .cross(&(verts[t[2]] - verts[t[0]]))
+                .norm()
+            / 3.0;
+        for &v in t {
+            weight[v] += a;
+        }
+    }
+    let threshold = (1.0 + params.corner_margin) / r_ins;
+    let (mut sw, mut swr, mut swk) = (0.0, 0.0, 0.0);
+    for (p, w) in verts.iter().zip(&weight) {
+        if let Some(k) = max_principal_curvature(grid, p)
+            && k > threshold
+        {
+            sw += w;
+            swr += w / k;
+            swk += w * k;
+        }
+    }
+    if sw == 0.0 {
+        return Ok(1.0);
+    }
+    let r_corner = match params.averaging {
+        CornerAveraging::Radius => swr / sw,
+        CornerAveraging::Curvature => sw / swk,
+    };
+    Ok((r_corner / r_ins).min(1.0))
+}
+
+/// The requested descriptors of many grains as a [`DnaTable`].
+///
+/// # Errors
+/// As [`measure`] (the first failing grain), and the table's own checks.
+pub fn measure_table(
+    grids: &[Grid],
+    wanted: &[Descriptor],
+    params: &MeasureParams,
+) -> Result<DnaTable> {
+    let mut table = DnaTable::new(wanted.to_vec())?;
+    for g in grids {
+        table.push_row(&measure(g, wanted, params)?)?;
+    }
+    Ok(table)
+}
+
+/// Descriptors of a star-shaped grain given by its radius function about
+/// `centre` (e.g. a spherical-harmonic model), measured on a level set built
+/// with `spec` (which must contain the grain with a margin).
+///
+/// # Errors
+/// Level-set construction errors ([`Error::LevelSet`]) and those of
+/// [`measure`].
+pub fn measure_star(
+    spec: GridSpec,
+    centre: &Point3<f64>,
+    radius: impl FnMut(Unit<Vector3<f64>>) -> f64,
+    wanted: &[Descriptor],
+    params: &MeasureParams,
+) -> Result<Vec<f64>> {
+    let (grid, _) =
+        Grid::from_star(spec, centre, radius, &StarParams::default()).map_err(ls_err)?;
+    measure(&grid, wanted, params)
+}
+
+/// Radii of the grain along the nodes of `mesh` in its principal frame
+/// (flat node order of [`SphericalMesh`]).
+///
+/// # Errors
+/// [`Error::InvalidMesh`]; [`Error::InvalidParameter`] if the centroid is
+/// outside the grain or a ray leaves the grid without crossing the surface.
+pub fn radial_profile(
+    grid: &Grid,
+    frame: &PrincipalFrame,
+    mesh: &SphericalMesh,
+) -> Result<Vec<f64>> {
+    mesh.validate()?;
+    let c = frame.centroid;
+    let inside = grid.try_value(&c).is_some_and(|v| v < 0.0);
+    if !inside {
+        return Err(Error::InvalidParameter {
+            name: "centroid",
+            value: grid.try_value(&c).unwrap_or(f64::NAN),
+            reason: "the centroid must be inside the grain for a radial profile",
+        });
+    }
+    let h = grid.spacing();
+    let max_t = {
+        let spec = grid.spec();
+        let d = Vector3::new(
+            spec.dims[0] as f64,
+            spec.dims[1] as f64,
+            spec.dims[2] as f64,
+        ) * h;
+        d.norm()
+    };
+    let mut out = Vec::with_capacity(mesh.n_nodes());
+    for (theta, phi) in mesh.node_angles() {
+        let d = frame.direction(theta, phi);
+        let at = |t: f64| grid.try_value(&(c + d.into_inner() * t));
+        let step = 0.5 * h;
+        let mut t0 = 0.0;
+        let mut t1 = step;
+        loop {
+            match at(t1) {
+                Some(v) if v >= 0.0 => break,
+                Some(_) if t1 < max_t => {
+                    t0 = t1;
+                    t1 += step;
+                }
+                _ => {
+                    return Err(Error::InvalidParameter {
+                        name: "ray length",
+                        value: t1,
+                        reason: "the surface must cross every ray inside the grid",
+                    });
+                }
+            }
+        }
+        for _ in 0..60 {
+            let tm = 0.5 * (t0 + t1);
+            if at(tm).is_some_and(|v| v < 0.0) {
+                t0 = tm;
+            } else {
+                t1 = tm;
+            }
+            if t1 - t0 < 1e-10 * h {
+                break;
+            }
+        }
+        out.push(0.5 * (t0 + t1));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests;
