@@ -22,13 +22,13 @@
 //! * [`compare_populations`]: Medina 2018 Tables 4–5 errors, KS, W1 and
 //!   correlation-matrix differences.
 //!
-//! * [`measure`]: the per-grain descriptors of a `levelset::Grid` (only
+//! * [`measure()`]: the per-grain descriptors of a `levelset::Grid` (only
 //!   those asked for are computed), [`measure_star`] for any star-shaped
 //!   radius function (e.g. a spherical-harmonic model), [`measure_table`] for
 //!   a population; [`principal_frame`] (deterministic axis signs) and
 //!   [`radial_profile`] on a [`SphericalMesh`]; [`convex_hull_volume`]
 //!   (Quickhull) for the convexity. Definitions and the roundness corner rule
-//!   are in the [`measure`] module docs.
+//!   are in the [`mod@measure`] module docs.
 //!
 //! # Example
 //!
