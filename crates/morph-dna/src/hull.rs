@@ -149,13 +149,13 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
             f.outside.push(p);
         }
     }
-    let mut cursor = 0;
-    // next face with outside points (deterministic scan order)
-    while let Some(fi) = (cursor..faces.len())
-        .chain(0..cursor)
-        .find(|&i| faces[i].alive && !faces[i].outside.is_empty())
-    {
-        cursor = fi;
+    let mut in_visible: Vec<bool> = Vec::new();
+    // work list of faces that may have outside points (LIFO, deterministic)
+    let mut pending: Vec<usize> = (0..faces.len()).collect();
+    while let Some(fi) = pending.pop() {
+        if !faces[fi].alive || faces[fi].outside.is_empty() {
+            continue;
+        }
         let eye = *faces[fi]
             .outside
             .iter()
@@ -169,6 +169,8 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
         // visible region: connected faces seen from the eye, by a walk over
         // the edge adjacency starting at the face the eye was chosen from;
         // the horizon is where the walk meets a face that is not visible
+        in_visible.resize(faces.len(), false);
+        in_visible[fi] = true;
         let mut visible = vec![fi];
         let mut seen = BTreeMap::new();
         seen.insert(fi, true);
@@ -188,7 +190,8 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
                     .entry(nb)
                     .or_insert_with(|| faces[nb].distance(&ep) > eps);
                 if vis {
-                    if !visible.contains(&nb) {
+                    if !in_visible[nb] {
+                        in_visible[nb] = true;
                         visible.push(nb);
                     }
                 } else {
@@ -197,6 +200,7 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
             }
         }
         for &i in &visible {
+            in_visible[i] = false;
             let v = faces[i].v;
             for k in 0..3 {
                 edge_face.remove(&(v[k], v[(k + 1) % 3]));
@@ -224,6 +228,7 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
                 f.outside.push(p);
             }
         }
+        pending.extend((first_new..faces.len()).filter(|&i| !faces[i].outside.is_empty()));
     }
     Ok(faces.into_iter().filter(|f| f.alive).map(|f| f.v).collect())
 }
