@@ -1,3 +1,5 @@
+//! Round-trip, malformed-input and property tests of the readers and writers.
+
 use super::*;
 use crate::error::Error;
 use crate::grid::{Grid, GridSpec};
