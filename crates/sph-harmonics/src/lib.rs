@@ -9,6 +9,7 @@
 //! [`integrals`] (volume, area, centroid, inertia; thesis cell integration and Gauss
 //! quadrature), [`curvature`] (mean/Gaussian curvature, principal radii, Gauss–Bonnet),
 //! [`contact`] (Hertz with curvature correction), [`shapes`] (analytic reference shapes),
+//! [`sampling`] (the sampling strategies q = 1..8 and error norms of §2.2/§3.3)
 //! and [`vcctl`] (the `*-anm-*.dat` reader).
 //!
 //! # Conventions
@@ -46,6 +47,7 @@ pub mod fit;
 pub mod grid;
 pub mod integrals;
 pub mod model;
+pub mod sampling;
 pub mod shapes;
 pub mod vcctl;
 

@@ -180,7 +180,7 @@ impl ShModel {
         check_angles(theta, phi)?;
         let leg = Legendre::new(self.degree)?;
         let mut v = leg.buffer(0);
-        Ok(self.radius_with(&leg, &mut v, theta, phi))
+        Ok(self.radius_with_buffer(&leg, &mut v, theta, phi))
     }
 
     /// Radius and derivatives at (θ, φ). At the poles the φ-derivatives vanish and the
@@ -209,7 +209,7 @@ impl ShModel {
         let mut v = leg.buffer(0);
         Ok(directions
             .iter()
-            .map(|&(t, p)| self.radius_with(&leg, &mut v, t, p))
+            .map(|&(t, p)| self.radius_with_buffer(&leg, &mut v, t, p))
             .collect())
     }
 
@@ -221,11 +221,34 @@ impl ShModel {
         let leg = Legendre::new(self.degree)?;
         let mut v = leg.buffer(0);
         let mut out = Vec::with_capacity(grid.len());
+        let n = self.degree + 1;
+        // Trigonometric table (cos mφ_j, sin mφ_j) shared by consecutive rings with the same
+        // azimuths, so the per-point work is a vectorisable dot product.
+        let mut key: Option<(usize, u64)> = None;
+        let mut table: Vec<f64> = Vec::new();
+        let mut cm = vec![0.0; 2 * n];
         for ring in grid.rings() {
             leg.compute(ring.theta, &mut v);
             let sums = self.ring_sums(&v, 0);
-            for j in 0..ring.n_phi {
-                out.push(sums.value_at(ring.phi(j)));
+            let this = (ring.n_phi, ring.phi0.to_bits());
+            if key != Some(this) {
+                key = Some(this);
+                table.clear();
+                for j in 0..ring.n_phi {
+                    let phi = ring.phi(j);
+                    for m in 0..n {
+                        let (sm, cmv) = (m as f64 * phi).sin_cos();
+                        table.push(cmv);
+                        table.push(sm);
+                    }
+                }
+            }
+            for m in 0..n {
+                cm[2 * m] = sums.c[m][0];
+                cm[2 * m + 1] = sums.s[m][0];
+            }
+            for row in table.chunks_exact(2 * n) {
+                out.push(row.iter().zip(&cm).map(|(a, b)| a * b).sum());
             }
         }
         Ok(out)
@@ -285,7 +308,13 @@ impl ShModel {
         crate::fit::quadrature_transform(&grid, &values, self.degree)
     }
 
-    fn radius_with(&self, leg: &Legendre, v: &mut LegendreValues, theta: f64, phi: f64) -> f64 {
+    pub(crate) fn radius_with_buffer(
+        &self,
+        leg: &Legendre,
+        v: &mut LegendreValues,
+        theta: f64,
+        phi: f64,
+    ) -> f64 {
         leg.compute(theta, v);
         let sqrt2 = std::f64::consts::SQRT_2;
         let (s1, c1) = phi.sin_cos();
@@ -319,6 +348,24 @@ impl ShModel {
         let n = self.degree + 1;
         let mut c = vec![[0.0; 3]; n];
         let mut s = vec![[0.0; 3]; n];
+        if derivatives == 0 {
+            for m in 0..=self.degree {
+                let f = if m == 0 { 1.0 } else { sqrt2 };
+                let base = tri(m, m);
+                let (mut cs, mut ss) = (0.0, 0.0);
+                for l in m..=self.degree {
+                    // tri(l, m) = tri(l, 0) + m; consecutive l differ by l.
+                    let p = v.p[base + (l * (l + 1) - m * (m + 1)) / 2];
+                    cs += self.coefficients[l * l + l + m] * p;
+                    if m > 0 {
+                        ss += self.coefficients[l * l + l - m] * p;
+                    }
+                }
+                c[m][0] = f * cs;
+                s[m][0] = f * ss;
+            }
+            return RingSums { c, s };
+        }
         for m in 0..=self.degree {
             let f = if m == 0 { 1.0 } else { sqrt2 };
             for l in m..=self.degree {
@@ -341,20 +388,6 @@ impl ShModel {
 }
 
 impl RingSums {
-    /// r only.
-    pub(crate) fn value_at(&self, phi: f64) -> f64 {
-        let (s1, c1) = phi.sin_cos();
-        let (mut sm, mut cm) = (0.0_f64, 1.0_f64);
-        let mut r = self.c[0][0];
-        for m in 1..self.c.len() {
-            let c_next = cm * c1 - sm * s1;
-            sm = sm * c1 + cm * s1;
-            cm = c_next;
-            r += self.c[m][0] * cm + self.s[m][0] * sm;
-        }
-        r
-    }
-
     /// r and all derivatives (requires sums computed with derivatives = 2).
     pub(crate) fn at(&self, phi: f64) -> RadiusDerivatives {
         let (s1, c1) = phi.sin_cos();
