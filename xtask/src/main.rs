@@ -14,6 +14,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod dna;
 mod validate_cmd;
 
 #[cfg(test)]
@@ -31,11 +32,25 @@ struct Cli {
 enum Command {
     /// Run the reference validation cases and print the result table.
     Validate(validate_cmd::Validate),
+    /// Measure the morphological DNA of every shipped real grain into
+    /// `fixtures/dna/` (`--check` verifies the committed table).
+    Dna(dna::Dna),
+}
+
+/// The workspace root (xtask's parent folder).
+fn workspace_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map_or_else(
+            || std::path::PathBuf::from("."),
+            std::path::Path::to_path_buf,
+        )
 }
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Validate(cmd) => cmd.run(),
+        Command::Dna(cmd) => cmd.run(&workspace_root()),
     }
 }
