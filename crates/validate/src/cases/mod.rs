@@ -7,6 +7,7 @@ mod fixture_integrity;
 mod levelset;
 mod packer_quadtree;
 mod rounding;
+mod sph_harmonics;
 
 /// Every registered case, in a stable order.
 #[must_use]
@@ -15,6 +16,7 @@ pub fn registry() -> Vec<Case> {
     cases.extend(fixture_integrity::cases());
     cases.extend(levelset::cases());
     cases.extend(packer_quadtree::cases());
+    cases.extend(sph_harmonics::cases());
     cases
 }
 
@@ -25,5 +27,6 @@ pub fn expected_failures() -> Vec<ExpectedFailure> {
     list.extend_from_slice(fixture_integrity::EXPECTED_FAILURES);
     list.extend_from_slice(levelset::EXPECTED_FAILURES);
     list.extend_from_slice(packer_quadtree::EXPECTED_FAILURES);
+    list.extend_from_slice(sph_harmonics::EXPECTED_FAILURES);
     list
 }
