@@ -10,7 +10,7 @@
 //! quadrature), [`curvature`] (mean/Gaussian curvature, principal radii, Gauss–Bonnet),
 //! [`contact`] (Hertz with curvature correction), [`shapes`] (analytic reference shapes),
 //! [`sampling`] (the sampling strategies q = 1..8 and error norms of §2.2/§3.3)
-//! and [`vcctl`] (the `*-anm-*.dat` reader).
+//! [`segmentation`] (piecewise models, Eqs. 4.1–4.2) and [`vcctl`] (the `*-anm-*.dat` reader).
 //!
 //! # Conventions
 //!
@@ -48,6 +48,7 @@ pub mod grid;
 pub mod integrals;
 pub mod model;
 pub mod sampling;
+pub mod segmentation;
 pub mod shapes;
 pub mod vcctl;
 
