@@ -620,4 +620,19 @@ mod tests {
             Err(Error::DegreeTooHighForGrid { .. })
         ));
     }
+
+    proptest::proptest! {
+        #[test]
+        fn fit_evaluate_round_trip(degree in 0usize..10, seed in 0u64..1000) {
+            let model = random_model(degree, seed);
+            let grid = RingGrid::gauss_legendre(degree).expect("grid");
+            let values = model.evaluate_grid(&grid).expect("values");
+            let back = quadrature_transform(&grid, &values, degree).expect("transform");
+            proptest::prop_assert!(max_diff(&model, &back) < 1e-12, "seed {}", seed);
+            let dense = RingGrid::equiangular_with_poles(2 * degree + 4, 2 * degree + 3).expect("grid");
+            let values = model.evaluate_grid(&dense).expect("values");
+            let fit = least_squares_rings(&dense, &values, degree).expect("fit");
+            proptest::prop_assert!(max_diff(&model, &fit.model) < 1e-11, "seed {}", seed);
+        }
+    }
 }
