@@ -14,6 +14,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod convergence;
 mod dna;
 mod validate_cmd;
 
@@ -35,6 +36,9 @@ enum Command {
     /// Measure the morphological DNA of every shipped real grain into
     /// `fixtures/dna/` (`--check` verifies the committed table).
     Dna(dna::Dna),
+    /// Write the spherical-harmonic convergence table of the reference
+    /// shapes (degree 1..30).
+    Convergence(convergence::Convergence),
 }
 
 /// The workspace root (xtask's parent folder).
@@ -52,5 +56,6 @@ fn main() -> anyhow::Result<()> {
     match cli.command {
         Command::Validate(cmd) => cmd.run(),
         Command::Dna(cmd) => cmd.run(&workspace_root()),
+        Command::Convergence(cmd) => cmd.run(&workspace_root()),
     }
 }
