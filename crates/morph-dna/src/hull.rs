@@ -2,12 +2,13 @@
 //! 1996, doi:10.1145/235815.235821), used for the convexity descriptor.
 
 use nalgebra::{Point3, Vector3};
-use std::collections::BTreeMap;
 
 use crate::error::{Error, Result};
 
 struct Face {
     v: [usize; 3],
+    /// `nb[k]`: the face across edge `(v[k], v[k+1])`.
+    nb: [usize; 3],
     normal: Vector3<f64>,
     offset: f64,
     outside: Vec<usize>,
@@ -22,6 +23,7 @@ impl Face {
         let normal = if len > 0.0 { n / len } else { Vector3::zeros() };
         Self {
             v,
+            nb: [usize::MAX; 3],
             normal,
             offset: normal.dot(&a.coords),
             outside: Vec::new(),
@@ -134,10 +136,13 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
     for v in tet {
         faces.push(Face::new(points, v));
     }
-    let mut edge_face: BTreeMap<(usize, usize), usize> = BTreeMap::new();
-    for (id, f) in faces.iter().enumerate() {
+    // adjacency of the tetrahedron
+    for f in 0..4 {
         for k in 0..3 {
-            edge_face.insert((f.v[k], f.v[(k + 1) % 3]), id);
+            let (a, b) = (faces[f].v[k], faces[f].v[(k + 1) % 3]);
+            let twin = (0..4)
+                .find(|&g| (0..3).any(|j| faces[g].v[j] == b && faces[g].v[(j + 1) % 3] == a));
+            faces[f].nb[k] = twin.ok_or_else(|| degenerate("inconsistent initial tetrahedron"))?;
         }
     }
     let used = [i0, i1, i2, i3];
@@ -149,13 +154,18 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
             f.outside.push(p);
         }
     }
-    let mut in_visible: Vec<bool> = Vec::new();
+    // visibility memo per iteration: stamp[f] == iteration ⇒ visible[f] valid
+    let mut stamp: Vec<usize> = Vec::new();
+    let mut seen_visible: Vec<bool> = Vec::new();
+    let mut in_region: Vec<bool> = Vec::new();
     // work list of faces that may have outside points (LIFO, deterministic)
     let mut pending: Vec<usize> = (0..faces.len()).collect();
+    let mut iteration = 0usize;
     while let Some(fi) = pending.pop() {
         if !faces[fi].alive || faces[fi].outside.is_empty() {
             continue;
         }
+        iteration += 1;
         let eye = *faces[fi]
             .outside
             .iter()
@@ -166,58 +176,62 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
             })
             .unwrap_or(&faces[fi].outside[0]);
         let ep = points[eye];
-        // visible region: connected faces seen from the eye, by a walk over
-        // the edge adjacency starting at the face the eye was chosen from;
-        // the horizon is where the walk meets a face that is not visible
-        in_visible.resize(faces.len(), false);
-        in_visible[fi] = true;
+        // visible region: connected faces seen from the eye, walked over the
+        // adjacency from the face the eye was chosen from; the horizon is
+        // where the walk meets a face that is not visible
+        stamp.resize(faces.len(), 0);
+        seen_visible.resize(faces.len(), false);
+        in_region.resize(faces.len(), false);
+        in_region[fi] = true;
         let mut visible = vec![fi];
-        let mut seen = BTreeMap::new();
-        seen.insert(fi, true);
-        let mut horizon = Vec::new();
+        // (a, b, face across) for each horizon edge
+        let mut horizon: Vec<(usize, usize, usize)> = Vec::new();
         let mut cur = 0;
         while cur < visible.len() {
             let f = visible[cur];
             cur += 1;
-            let v = faces[f].v;
             for k in 0..3 {
-                let (a, b) = (v[k], v[(k + 1) % 3]);
-                let Some(&nb) = edge_face.get(&(b, a)) else {
-                    horizon.push((a, b));
-                    continue;
-                };
-                let vis = *seen
-                    .entry(nb)
-                    .or_insert_with(|| faces[nb].distance(&ep) > eps);
-                if vis {
-                    if !in_visible[nb] {
-                        in_visible[nb] = true;
+                let nb = faces[f].nb[k];
+                if stamp[nb] != iteration {
+                    stamp[nb] = iteration;
+                    seen_visible[nb] = in_region[nb] || faces[nb].distance(&ep) > eps;
+                }
+                if seen_visible[nb] {
+                    if !in_region[nb] {
+                        in_region[nb] = true;
                         visible.push(nb);
                     }
                 } else {
-                    horizon.push((a, b));
+                    horizon.push((faces[f].v[k], faces[f].v[(k + 1) % 3], nb));
                 }
-            }
-        }
-        for &i in &visible {
-            in_visible[i] = false;
-            let v = faces[i].v;
-            for k in 0..3 {
-                edge_face.remove(&(v[k], v[(k + 1) % 3]));
             }
         }
         let mut orphans = Vec::new();
         for &i in &visible {
+            in_region[i] = false;
             faces[i].alive = false;
             orphans.append(&mut faces[i].outside);
         }
         let first_new = faces.len();
-        for (a, b) in horizon {
+        for &(a, b, across) in &horizon {
             let id = faces.len();
-            for e in [(a, b), (b, eye), (eye, a)] {
-                edge_face.insert(e, id);
-            }
-            faces.push(Face::new(points, [a, b, eye]));
+            let mut face = Face::new(points, [a, b, eye]);
+            face.nb[0] = across;
+            let k = (0..3)
+                .find(|&j| faces[across].v[j] == b && faces[across].v[(j + 1) % 3] == a)
+                .ok_or_else(|| degenerate("numerically degenerate point set"))?;
+            faces[across].nb[k] = id;
+            faces.push(face);
+        }
+        // link the fan of new faces around the eye
+        for (i, &(a, b, _)) in horizon.iter().enumerate() {
+            let next = horizon.iter().position(|&(s, _, _)| s == b);
+            let prev = horizon.iter().position(|&(_, e, _)| e == a);
+            let (Some(next), Some(prev)) = (next, prev) else {
+                return Err(degenerate("numerically degenerate point set"));
+            };
+            faces[first_new + i].nb[1] = first_new + next;
+            faces[first_new + i].nb[2] = first_new + prev;
         }
         for p in orphans {
             if p == eye {
@@ -306,7 +320,7 @@ mod manifold_tests {
         .expect("grid");
         let m = g.marching_cubes();
         let f = convex_hull(m.vertices()).expect("hull");
-        let mut edges = BTreeMap::new();
+        let mut edges = std::collections::BTreeMap::new();
         for t in &f {
             for k in 0..3 {
                 *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;

@@ -262,21 +262,19 @@ pub fn max_principal_curvature(grid: &Grid, p: &Point3<f64>) -> Option<f64> {
         return None;
     }
     let n = g / gn;
-    let proj = Matrix3::identity() - n * n.transpose();
-    let shape = proj * hess * proj / gn;
-    let eig = SymmetricEigen::new(shape);
-    // drop the eigenvalue whose eigenvector is the normal
-    let mut best = (0usize, -1.0);
-    for a in 0..3 {
-        let align = eig.eigenvectors.column(a).dot(&n).abs();
-        if align > best.1 {
-            best = (a, align);
-        }
-    }
-    (0..3)
-        .filter(|&a| a != best.0)
-        .map(|a| eig.eigenvalues[a])
-        .reduce(f64::max)
+    // tangent basis (t1, t2) of the level set; the shape operator restricted
+    // to it is the symmetric 2×2 matrix [tᵢ·H·tⱼ]/|∇φ|, whose larger
+    // eigenvalue (closed form) is κ₁
+    let helper = if n.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let t1 = n.cross(&helper).normalize();
+    let t2 = n.cross(&t1);
+    let (h1, h2) = (hess * t1, hess * t2);
+    let a = t1.dot(&h1) / gn;
+    let b = t1.dot(&h2) / gn;
+    let d = t2.dot(&h2) / gn;
+    let half_trace = 0.5 * (a + d);
+    let k1 = half_trace + (0.25 * (a - d) * (a - d) + b * b).sqrt();
+    k1.is_finite().then_some(k1)
 }
 
 /// The requested descriptors of the grain represented by `grid`, in the order
