@@ -265,7 +265,11 @@ pub fn max_principal_curvature(grid: &Grid, p: &Point3<f64>) -> Option<f64> {
     // tangent basis (t1, t2) of the level set; the shape operator restricted
     // to it is the symmetric 2×2 matrix [tᵢ·H·tⱼ]/|∇φ|, whose larger
     // eigenvalue (closed form) is κ₁
-    let helper = if n.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let helper = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
     let t1 = n.cross(&helper).normalize();
     let t2 = n.cross(&t1);
     let (h1, h2) = (hess * t1, hess * t2);
