@@ -569,6 +569,49 @@ fn threshold_row(t: &Table) -> Result<usize, Error> {
     t.row_where("row_type", "threshold")
 }
 
+/// `δ = |x − x_ref| / x_ref` of the printed `value` column, against the
+/// printed `delta` column.
+fn relative_deviation(
+    t: &Table,
+    r: usize,
+    label: &str,
+    value: &str,
+    delta: &str,
+    reference: Iv,
+) -> Result<Check, Error> {
+    let x = cell(t, r, value)?;
+    Ok(consistent(
+        &format!("{label} {delta}"),
+        cell(t, r, delta)?,
+        x.sub(reference).abs().div(reference),
+    ))
+}
+
+/// `δ_LS = |E / E_thr − 1|` under the metric `delta_LS` and, with
+/// `n_thr`, the average deviation `E / N_thr` under `avg_deviation`.
+fn least_squares_checks(
+    t: &Table,
+    r: usize,
+    label: &str,
+    thr: Iv,
+    n_thr: Option<Iv>,
+) -> Result<Vec<Check>, Error> {
+    let e = cell(t, r, "LS_error_norm")?;
+    let mut checks = vec![consistent(
+        &format!("{label} delta_LS"),
+        cell(t, r, "delta_LS")?,
+        e.div(thr).sub(Iv::exact(1.0)).abs(),
+    )];
+    if let Some(n) = n_thr {
+        checks.push(consistent(
+            &format!("{label} avg_deviation"),
+            cell(t, r, "avg_deviation")?,
+            e.div(n),
+        ));
+    }
+    Ok(checks)
+}
+
 fn radvilaite_table3_1() -> Result<Vec<Check>, Error> {
     let t = Table::reference("radvilaite2016_table3_1_ellipsoid_L1.csv")?;
     let thr = cell(&t, threshold_row(&t)?, "LS_error_norm")?;
@@ -578,29 +621,18 @@ fn radvilaite_table3_1() -> Result<Vec<Check>, Error> {
     let n_thr = Iv::exact(16258.0);
     let mut checks = Vec::new();
     for (r, label) in model_rows(&t)? {
-        let e = cell(&t, r, "LS_error_norm")?;
-        checks.push(consistent(
-            &format!("{label} delta_LS"),
-            cell(&t, r, "delta_LS")?,
-            e.div(thr).sub(Iv::exact(1.0)).abs(),
-        ));
-        checks.push(consistent(
-            &format!("{label} avg_deviation"),
-            cell(&t, r, "avg_deviation")?,
-            e.div(n_thr),
-        ));
-        let s = cell(&t, r, "S_surface_area")?;
-        checks.push(consistent(
-            &format!("{label} delta_S"),
-            cell(&t, r, "delta_S")?,
-            s.sub(s_ref).abs().div(s_ref),
-        ));
-        let v = cell(&t, r, "V_volume")?;
-        checks.push(consistent(
-            &format!("{label} delta_V"),
-            cell(&t, r, "delta_V")?,
-            v.sub(v_ref).abs().div(v_ref),
-        ));
+        checks.extend(least_squares_checks(&t, r, &label, thr, Some(n_thr))?);
+        checks.push(relative_deviation(
+            &t,
+            r,
+            &label,
+            "S_surface_area",
+            "delta_S",
+            s_ref,
+        )?);
+        checks.push(relative_deviation(
+            &t, r, &label, "V_volume", "delta_V", v_ref,
+        )?);
         checks.push(node_count_check(&t, r, &label)?);
     }
     Ok(checks)
@@ -614,23 +646,15 @@ fn radvilaite_table3_2() -> Result<Vec<Check>, Error> {
     let s_ref = cell(&t, t.row_where("row_type", "analytical")?, "S_surface_area")?;
     let mut checks = Vec::new();
     for (r, label) in model_rows(&t)? {
-        let e = cell(&t, r, "LS_error_norm")?;
-        checks.push(consistent(
-            &format!("{label} delta_LS"),
-            cell(&t, r, "delta_LS")?,
-            e.div(thr).sub(Iv::exact(1.0)).abs(),
-        ));
-        checks.push(consistent(
-            &format!("{label} avg_deviation"),
-            cell(&t, r, "avg_deviation")?,
-            e.div(n_thr),
-        ));
-        let s = cell(&t, r, "S_surface_area")?;
-        checks.push(consistent(
-            &format!("{label} delta_S"),
-            cell(&t, r, "delta_S")?,
-            s.sub(s_ref).abs().div(s_ref),
-        ));
+        checks.extend(least_squares_checks(&t, r, &label, thr, Some(n_thr))?);
+        checks.push(relative_deviation(
+            &t,
+            r,
+            &label,
+            "S_surface_area",
+            "delta_S",
+            s_ref,
+        )?);
         checks.push(node_count_check(&t, r, &label)?);
     }
     Ok(checks)
@@ -648,12 +672,7 @@ fn radvilaite_table3_3() -> Result<Vec<Check>, Error> {
         thr.div(n_thr),
     ));
     for (r, label) in model_rows(&t)? {
-        let e = cell(&t, r, "LS_error_norm")?;
-        checks.push(consistent(
-            &format!("{label} delta_LS"),
-            cell(&t, r, "delta_LS")?,
-            e.div(thr).sub(Iv::exact(1.0)).abs(),
-        ));
+        checks.extend(least_squares_checks(&t, r, &label, thr, None)?);
         checks.push(node_count_check(&t, r, &label)?);
     }
     Ok(checks)
@@ -673,29 +692,18 @@ fn radvilaite_table3_4() -> Result<Vec<Check>, Error> {
         thr.div(n_thr),
     ));
     for (r, label) in model_rows(&t)? {
-        let e = cell(&t, r, "LS_error_norm")?;
-        checks.push(consistent(
-            &format!("{label} delta_LS"),
-            cell(&t, r, "delta_LS")?,
-            e.div(thr).sub(Iv::exact(1.0)).abs(),
-        ));
-        checks.push(consistent(
-            &format!("{label} avg_deviation"),
-            cell(&t, r, "avg_deviation")?,
-            e.div(n_thr),
-        ));
-        let a = cell(&t, r, "A_surface_area")?;
-        checks.push(consistent(
-            &format!("{label} delta_A"),
-            cell(&t, r, "delta_A")?,
-            a.sub(a_ref).abs().div(a_ref),
-        ));
-        let v = cell(&t, r, "V_volume")?;
-        checks.push(consistent(
-            &format!("{label} delta_V"),
-            cell(&t, r, "delta_V")?,
-            v.sub(v_ref).abs().div(v_ref),
-        ));
+        checks.extend(least_squares_checks(&t, r, &label, thr, Some(n_thr))?);
+        checks.push(relative_deviation(
+            &t,
+            r,
+            &label,
+            "A_surface_area",
+            "delta_A",
+            a_ref,
+        )?);
+        checks.push(relative_deviation(
+            &t, r, &label, "V_volume", "delta_V", v_ref,
+        )?);
         checks.push(node_count_check(&t, r, &label)?);
     }
     Ok(checks)
