@@ -39,7 +39,7 @@
 //!   of the grid spacing); this is the grain's radius for star-shaped grains
 //!   and the first boundary crossing otherwise.
 
-use nalgebra::{Matrix3, Point3, SymmetricEigen, Unit, Vector3};
+use nalgebra::{Matrix3, Point3, Unit, Vector3};
 
 use levelset::{Grid, GridSpec, StarParams};
 
@@ -116,17 +116,11 @@ impl PrincipalFrame {
 /// [`Error::LevelSet`] if the grid holds no closed surface.
 pub fn principal_frame(grid: &Grid) -> Result<PrincipalFrame> {
     let mp = grid.mass_properties().map_err(ls_err)?;
-    let eig = SymmetricEigen::new(mp.inertia);
-    let mut idx = [0usize, 1, 2];
-    idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
-    let moments = Vector3::new(
-        eig.eigenvalues[idx[0]],
-        eig.eigenvalues[idx[1]],
-        eig.eigenvalues[idx[2]],
-    );
-    let mut e: Vec<Vector3<f64>> = idx
-        .iter()
-        .map(|&i| eig.eigenvectors.column(i).into_owned())
+    // levelset's decomposition: moments ascending, axes as matching columns
+    let principal = mp.principal();
+    let moments = principal.moments;
+    let mut e: Vec<Vector3<f64>> = (0..3)
+        .map(|a| principal.axes.column(a).into_owned())
         .collect();
     // third moments along the first two axes over the (smoothed) interior
     let spec = grid.spec();
@@ -290,28 +284,29 @@ pub fn max_principal_curvature(grid: &Grid, p: &Point3<f64>) -> Option<f64> {
 /// box), [`Error::InvalidParameter`] for invalid params or a degenerate grain.
 pub fn measure(grid: &Grid, wanted: &[Descriptor], params: &MeasureParams) -> Result<Vec<f64>> {
     params.validate()?;
-    let need_mesh = wanted.iter().any(|d| {
+    let wants = |f: fn(&Descriptor) -> bool| wanted.iter().any(f);
+    let need_dims = wants(|d| {
         matches!(
             d,
-            Descriptor::MajorExtent
-                | Descriptor::IntermediateExtent
-                | Descriptor::MinorExtent
-                | Descriptor::Convexity
-                | Descriptor::Roundness
+            Descriptor::MajorPrincipalDimension
+                | Descriptor::IntermediatePrincipalDimension
+                | Descriptor::MinPrincipalDimension
+                | Descriptor::AspectRatio
+                | Descriptor::Elongation
+                | Descriptor::Flatness
         )
     });
-    let need_frame = need_mesh
-        || wanted.iter().any(|d| {
-            matches!(
-                d,
-                Descriptor::MajorPrincipalDimension
-                    | Descriptor::IntermediatePrincipalDimension
-                    | Descriptor::MinPrincipalDimension
-                    | Descriptor::AspectRatio
-                    | Descriptor::Elongation
-                    | Descriptor::Flatness
-            )
-        });
+    let need_extents = wants(|d| {
+        matches!(
+            d,
+            Descriptor::MajorExtent | Descriptor::IntermediateExtent | Descriptor::MinorExtent
+        )
+    });
+    // extents need the principal frame and the mesh; convexity and
+    // roundness need only the mesh
+    let need_mesh =
+        need_extents || wants(|d| matches!(d, Descriptor::Convexity | Descriptor::Roundness));
+    let need_frame = need_dims || need_extents;
     if grid.values().iter().all(|v| *v < 0.0) {
         return Err(Error::LevelSet {
             message: "every node is inside: the grain does not fit in its grid".into(),
@@ -325,21 +320,7 @@ pub fn measure(grid: &Grid, wanted: &[Descriptor], params: &MeasureParams) -> Re
         (mp.volume, mp.area, None)
     };
     let dims = match &frame {
-        Some(f)
-            if wanted.iter().any(|d| {
-                matches!(
-                    d,
-                    Descriptor::MajorPrincipalDimension
-                        | Descriptor::IntermediatePrincipalDimension
-                        | Descriptor::MinPrincipalDimension
-                        | Descriptor::AspectRatio
-                        | Descriptor::Elongation
-                        | Descriptor::Flatness
-                )
-            }) =>
-        {
-            Some(f.principal_dimensions()?)
-        }
+        Some(f) if need_dims => Some(f.principal_dimensions()?),
         _ => None,
     };
     let mesh = if need_mesh {
