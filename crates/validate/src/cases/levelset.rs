@@ -68,18 +68,7 @@ fn sphere_grid() -> Result<Grid, Error> {
 
 fn sphere() -> Result<Vec<Check>, Error> {
     let g = sphere_grid()?;
-    let h = g.spacing();
-    let [nx, ny, nz] = g.dims();
-    let mut worst = 0.0f64;
-    for k in 1..nz - 1 {
-        for j in 1..ny - 1 {
-            for i in 1..nx - 1 {
-                if g.at(i, j, k).abs() < 3.0 * h {
-                    worst = worst.max((g.node_gradient(i, j, k).norm() - 1.0).abs());
-                }
-            }
-        }
-    }
+    let worst = g.eikonal_error(3.0 * g.spacing());
     Ok(vec![
         Check::new(
             "volume",
