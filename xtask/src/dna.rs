@@ -132,8 +132,7 @@ fn measure_grain(model: &ShModel, resolution: usize) -> anyhow::Result<Vec<f64>>
     )?)
 }
 
-fn measure_all(resolution: usize) -> anyhow::Result<Vec<Row>> {
-    let geom = geom_table()?;
+fn measure_all(geom: &[(String, Geom)], resolution: usize) -> anyhow::Result<Vec<Row>> {
     let mut rows = Vec::new();
     for set in SETS {
         let files = validate::fixtures::grains_in(&format!("vcctl/{set}"), ".dat");
@@ -179,7 +178,7 @@ fn column(rows: &[&Row], d: Descriptor) -> Vec<f64> {
     rows.iter().map(|r| r.values[i]).collect()
 }
 
-fn report(rows: &[Row]) -> anyhow::Result<String> {
+fn report(rows: &[Row], geom: &[(String, Geom)]) -> anyhow::Result<String> {
     let mut md = String::from("# Morphological DNA of the shipped VCCTL grains\n\n");
     let _ = writeln!(
         md,
@@ -208,7 +207,6 @@ fn report(rows: &[Row]) -> anyhow::Result<String> {
         );
     }
     // Ottawa vs NIST geometry table
-    let geom = geom_table()?;
     let ottawa: Vec<&Row> = rows.iter().filter(|r| r.set == "ottawa").collect();
     let mut pairs = Vec::new();
     for r in &ottawa {
@@ -277,7 +275,7 @@ fn report(rows: &[Row]) -> anyhow::Result<String> {
         Descriptor::MEDINA_2018_TABLE_1.to_vec(),
         Descriptor::MEDINA_2018_TABLE_1
             .iter()
-            .map(|d| ours_all(&ottawa, *d))
+            .map(|d| column(&ottawa, *d))
             .collect(),
     )?;
     let corr = correlation_matrix(&table, CorrelationMethod::Pearson)?;
@@ -303,10 +301,6 @@ fn report(rows: &[Row]) -> anyhow::Result<String> {
     }
     md.push_str("\nThe seed's parents are a regolith simulant, ours Ottawa sand: the signs and magnitudes need not agree.\n");
     Ok(md)
-}
-
-fn ours_all(rows: &[&Row], d: Descriptor) -> Vec<f64> {
-    column(rows, d)
 }
 
 fn compare(committed: &str, fresh: &str) -> anyhow::Result<()> {
@@ -346,7 +340,8 @@ fn compare(committed: &str, fresh: &str) -> anyhow::Result<()> {
 impl Dna {
     pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
         let start = std::time::Instant::now();
-        let rows = measure_all(self.resolution)?;
+        let geom = geom_table()?;
+        let rows = measure_all(&geom, self.resolution)?;
         let csv = to_csv(&rows);
         let path = root.join(TABLE);
         if self.check {
@@ -361,7 +356,7 @@ impl Dna {
             return Ok(());
         }
         std::fs::write(&path, &csv).with_context(|| format!("writing {}", path.display()))?;
-        let md = report(&rows)?;
+        let md = report(&rows, &geom)?;
         let dir = root.join(&self.report);
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         let rp = dir.join("dna.md");
