@@ -1,0 +1,548 @@
+//! The parents and the population model fitted to them (Medina 2018,
+//! §2.1–2.3): measured DNA, principal frames, radial profiles on the
+//! spherical mesh, the surface DNA of those profiles, the target sampler and
+//! the radii sampler.
+
+use levelset::Grid;
+use morph_dna::{
+    AcceptanceRejection2d, BicubicPdf, Descriptor, DnaTable, GaussianCopula, Histogram1d,
+    Histogram2d, InverseCdfSampler1d, MeasureParams, PrincipalFrame, measure, principal_frame,
+    radial_profile,
+};
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::params::{Params, RadiiModel, TargetModel};
+use crate::surface::{MeshGeometry, SurfaceDna};
+
+/// The DNA measured on every parent and on every clone, in this order:
+/// aspect ratio, grain (equivalent) diameter, roundness, volume/surface
+/// ratio (Medina 2018, Tables 4–5), and the minimum principal dimension
+/// (Table 1).
+pub const DNA: [Descriptor; 5] = [
+    Descriptor::AspectRatio,
+    Descriptor::EquivalentDiameter,
+    Descriptor::Roundness,
+    Descriptor::VolumeSurfaceRatio,
+    Descriptor::MinPrincipalDimension,
+];
+
+/// The four parameters of Medina 2018, Tables 4–5, in their order.
+pub const TABLES_4_5: [Descriptor; 4] = [
+    Descriptor::AspectRatio,
+    Descriptor::EquivalentDiameter,
+    Descriptor::Roundness,
+    Descriptor::VolumeSurfaceRatio,
+];
+
+/// The descriptors a clone's targets are drawn for, in this order.
+pub const TARGETS: [Descriptor; 5] = [
+    Descriptor::AspectRatio,
+    Descriptor::MinPrincipalDimension,
+    Descriptor::Flatness,
+    Descriptor::Roundness,
+    Descriptor::VolumeSurfaceRatio,
+];
+
+/// Minimum number of parents of a population model.
+pub const MIN_PARENTS: usize = 2;
+
+/// Measured parent grains (level sets, any common length unit).
+#[derive(Debug, Clone)]
+pub struct Parents {
+    grids: Vec<Grid>,
+    frames: Vec<PrincipalFrame>,
+    dna: DnaTable,
+}
+
+impl Parents {
+    /// Measures the [`DNA`] and principal frame of every parent (in parallel;
+    /// the result does not depend on the thread count).
+    ///
+    /// # Errors
+    /// [`Error::NoParents`], [`Error::TooFewParents`], and
+    /// [`Error::DegenerateParent`] naming the first grain that cannot be
+    /// measured (empty or all-inside grid, flat body, non-finite descriptor).
+    pub fn from_grids(grids: Vec<Grid>, params: &MeasureParams) -> Result<Self> {
+        if grids.is_empty() {
+            return Err(Error::NoParents {
+                required: MIN_PARENTS,
+            });
+        }
+        if grids.len() < MIN_PARENTS {
+            return Err(Error::TooFewParents {
+                found: grids.len(),
+                required: MIN_PARENTS,
+            });
+        }
+        let measured: Vec<Result<(PrincipalFrame, Vec<f64>)>> = grids
+            .par_iter()
+            .enumerate()
+            .map(|(index, g)| {
+                let degenerate = |e: morph_dna::Error| Error::DegenerateParent {
+                    index,
+                    reason: e.to_string(),
+                };
+                let dna = measure(g, &DNA, params).map_err(degenerate)?;
+                let frame = principal_frame(g).map_err(degenerate)?;
+                Ok((frame, dna))
+            })
+            .collect();
+        let mut frames = Vec::with_capacity(grids.len());
+        let mut rows = Vec::with_capacity(grids.len());
+        for m in measured {
+            let (f, d) = m?;
+            frames.push(f);
+            rows.push(d);
+        }
+        let dna = DnaTable::from_rows(DNA.to_vec(), &rows)?;
+        Ok(Self { grids, frames, dna })
+    }
+
+    /// Number of parents.
+    pub fn len(&self) -> usize {
+        self.grids.len()
+    }
+
+    /// Always false (a parent set has at least [`MIN_PARENTS`] grains).
+    pub fn is_empty(&self) -> bool {
+        self.grids.is_empty()
+    }
+
+    /// The measured [`DNA`] table.
+    pub fn dna(&self) -> &DnaTable {
+        &self.dna
+    }
+
+    /// The parents' level sets.
+    pub fn grids(&self) -> &[Grid] {
+        &self.grids
+    }
+
+    /// The parents' principal frames.
+    pub fn frames(&self) -> &[PrincipalFrame] {
+        &self.frames
+    }
+}
+
+/// Sampled targets of one clone.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Targets {
+    /// Aspect ratio `S / L`.
+    pub aspect_ratio: f64,
+    /// Minimum principal dimension `S`.
+    pub min_dimension: f64,
+    /// Flatness `S / I`.
+    pub flatness: f64,
+    /// Roundness (surface-DNA measure).
+    pub roundness: f64,
+    /// Volume/surface ratio of the quality control.
+    pub volume_surface_ratio: f64,
+}
+
+impl Targets {
+    /// Full semi-axes `(L/2, I/2, S/2)` of the embryo ellipsoid (`I` clamped
+    /// into `[S, L]`).
+    pub fn semi_axes(&self) -> [f64; 3] {
+        let s = self.min_dimension;
+        let l = s / self.aspect_ratio;
+        let i = (s / self.flatness).clamp(s, l);
+        [0.5 * l, 0.5 * i, 0.5 * s]
+    }
+}
+
+#[derive(Debug, Clone)]
+enum TargetSampler {
+    Seed {
+        ar_s: AcceptanceRejection2d<BicubicPdf>,
+        s_vs: AcceptanceRejection2d<BicubicPdf>,
+        flatness: InverseCdfSampler1d,
+        roundness: InverseCdfSampler1d,
+    },
+    Copula(GaussianCopula),
+}
+
+#[derive(Debug, Clone)]
+enum RadiiSampler {
+    Seed {
+        marginals: Vec<InverseCdfSampler1d>,
+        /// Per ring node: correlation weights of its four neighbours.
+        weights: Vec<[f64; 4]>,
+    },
+    Copula {
+        marginals: Vec<InverseCdfSampler1d>,
+        /// `P × n` standardised normal scores, row-major by parent, divided
+        /// by `√(P − 1)` and scaled by `√(1 − shrinkage)`.
+        factor: Vec<f64>,
+        parents: usize,
+        noise: f64,
+    },
+}
+
+/// Why a candidate draw failed inside the target sampler.
+pub(crate) struct TargetUnavailable;
+
+/// The population model: everything a clone is sampled from.
+#[derive(Debug, Clone)]
+pub struct CloneModel {
+    pub(crate) params: Params,
+    pub(crate) geom: MeshGeometry,
+    surface: Vec<SurfaceDna>,
+    profiles: Vec<Vec<f64>>,
+    targets: TargetSampler,
+    radii: RadiiSampler,
+}
+
+fn check_spread(what: &'static str, x: &[f64]) -> Result<()> {
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if !(hi > lo) {
+        return Err(Error::ConstantParents { what, value: lo });
+    }
+    Ok(())
+}
+
+fn pearson_or_zero(a: &[f64], b: &[f64]) -> f64 {
+    morph_dna::stats::pearson(a, b).map_or(0.0, |r| if r.is_finite() { r.max(0.0) } else { 0.0 })
+}
+
+/// Normal scores `Φ⁻¹((rank − ½)/P)`-type (average ranks over `P + 1`).
+fn normal_scores(x: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| x[a].total_cmp(&x[b]));
+    let mut ranks = vec![0.0; n];
+    let mut k = 0;
+    while k < n {
+        let mut e = k;
+        while e + 1 < n && x[order[e + 1]] == x[order[k]] {
+            e += 1;
+        }
+        let r = 0.5 * (k + e) as f64 + 1.0;
+        for &o in &order[k..=e] {
+            ranks[o] = r;
+        }
+        k = e + 1;
+    }
+    ranks
+        .into_iter()
+        .map(|r| morph_dna::stats::normal_quantile(r / (n as f64 + 1.0)))
+        .collect()
+}
+
+impl CloneModel {
+    /// Fits the model of `params` to the parents: radial profiles on the
+    /// mesh (in each parent's principal frame), their surface DNA, the
+    /// target sampler and the radii sampler.
+    ///
+    /// # Errors
+    /// [`Params::validate`]'s errors, [`Error::TooManyBins`] for more bins
+    /// than parents, [`Error::DegenerateParent`] for a parent whose radial
+    /// profile or surface DNA cannot be computed (centroid outside the grain,
+    /// a ray that never leaves it), [`Error::ConstantParents`] when a target
+    /// descriptor or a node radius does not vary across parents.
+    pub fn fit(parents: &Parents, params: &Params) -> Result<Self> {
+        params.validate()?;
+        let p = parents.len();
+        if params.bins > p {
+            return Err(Error::TooManyBins {
+                bins: params.bins,
+                parents: p,
+            });
+        }
+        let geom = MeshGeometry::new(params.mesh);
+        let n = geom.n_nodes();
+        let measured: Vec<Result<(Vec<f64>, SurfaceDna)>> = parents
+            .grids
+            .par_iter()
+            .zip(&parents.frames)
+            .enumerate()
+            .map(|(index, (g, f))| {
+                let r =
+                    radial_profile(g, f, &params.mesh).map_err(|e| Error::DegenerateParent {
+                        index,
+                        reason: e.to_string(),
+                    })?;
+                let s = geom
+                    .surface_dna(&r, params.level_set_resolution, params.grid_margin)
+                    .ok_or_else(|| Error::DegenerateParent {
+                        index,
+                        reason: "its radial profile is not a valid star surface".into(),
+                    })?;
+                Ok((r, s))
+            })
+            .collect();
+        let mut profiles = Vec::with_capacity(p);
+        let mut surface = Vec::with_capacity(p);
+        for m in measured {
+            let (r, s) = m?;
+            profiles.push(r);
+            surface.push(s);
+        }
+        // targets in surface-DNA measure
+        let cols: Vec<Vec<f64>> = vec![
+            surface.iter().map(SurfaceDna::aspect_ratio).collect(),
+            surface.iter().map(|s| s.dims[2]).collect(),
+            surface.iter().map(SurfaceDna::flatness).collect(),
+            surface.iter().map(|s| s.roundness).collect(),
+            surface
+                .iter()
+                .map(SurfaceDna::volume_surface_ratio)
+                .collect(),
+        ];
+        for (d, c) in TARGETS.iter().zip(&cols) {
+            check_spread(d.name(), c)?;
+        }
+        let bins = params.bins;
+        let targets = match params.targets {
+            TargetModel::Copula => TargetSampler::Copula(GaussianCopula::fit(
+                &DnaTable::from_columns(TARGETS.to_vec(), cols.clone())?,
+            )?),
+            TargetModel::Seed => {
+                let pdf = |x: &[f64], y: &[f64]| -> Result<AcceptanceRejection2d<BicubicPdf>> {
+                    let h = Histogram2d::new(x, y, (bins, bins), None, None)?;
+                    Ok(AcceptanceRejection2d::new(BicubicPdf::from_histogram(
+                        &h, 4,
+                    )?)?)
+                };
+                let one = |x: &[f64]| -> Result<InverseCdfSampler1d> {
+                    Ok(InverseCdfSampler1d::from_histogram(&Histogram1d::new(
+                        x, bins, None,
+                    )?)?)
+                };
+                TargetSampler::Seed {
+                    ar_s: pdf(&cols[0], &cols[1])?,
+                    s_vs: pdf(&cols[1], &cols[4])?,
+                    flatness: one(&cols[2])?,
+                    roundness: one(&cols[3])?,
+                }
+            }
+        };
+        // normalised radii ρ = r / r_ellipsoid per node
+        let rho: Vec<Vec<f64>> = profiles
+            .iter()
+            .zip(&surface)
+            .map(|(r, s)| {
+                let semi = [0.5 * s.dims[0], 0.5 * s.dims[1], 0.5 * s.dims[2]];
+                (0..n)
+                    .map(|k| r[k] / geom.ellipsoid_radius(k, semi))
+                    .collect()
+            })
+            .collect();
+        let node_cols: Vec<Vec<f64>> = (0..n).map(|k| rho.iter().map(|r| r[k]).collect()).collect();
+        for c in &node_cols {
+            check_spread("normalised node radius", c)?;
+        }
+        let marginals = node_cols
+            .iter()
+            .map(|c| {
+                Ok(InverseCdfSampler1d::from_histogram(&Histogram1d::new(
+                    c, bins, None,
+                )?)?)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let radii = match params.radii {
+            RadiiModel::SeedNeighbourhood => {
+                let weights = (0..n)
+                    .map(|k| match geom.neighbours(k) {
+                        Some(nb) => nb.map(|m| pearson_or_zero(&node_cols[k], &node_cols[m])),
+                        None => [0.0; 4],
+                    })
+                    .collect();
+                RadiiSampler::Seed { marginals, weights }
+            }
+            RadiiModel::CopulaField { shrinkage } => {
+                let scale = ((1.0 - shrinkage) / (p as f64 - 1.0)).sqrt();
+                let mut factor = vec![0.0; p * n];
+                for (k, c) in node_cols.iter().enumerate() {
+                    let z = normal_scores(c);
+                    let mean = z.iter().sum::<f64>() / p as f64;
+                    let var =
+                        z.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (p as f64 - 1.0);
+                    let sd = var.sqrt();
+                    for (g, v) in z.iter().enumerate() {
+                        factor[g * n + k] = if sd > 0.0 {
+                            (v - mean) / sd * scale
+                        } else {
+                            0.0
+                        };
+                    }
+                }
+                RadiiSampler::Copula {
+                    marginals,
+                    factor,
+                    parents: p,
+                    noise: shrinkage.sqrt(),
+                }
+            }
+        };
+        Ok(Self {
+            params: *params,
+            geom,
+            surface,
+            profiles,
+            targets,
+            radii,
+        })
+    }
+
+    /// The parameters the model was fitted with.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The mesh geometry.
+    pub fn geometry(&self) -> &MeshGeometry {
+        &self.geom
+    }
+
+    /// Surface DNA of every parent's radial profile.
+    pub fn parent_surface_dna(&self) -> &[SurfaceDna] {
+        &self.surface
+    }
+
+    /// Every parent's radii at the mesh nodes (principal frame).
+    pub fn parent_profiles(&self) -> &[Vec<f64>] {
+        &self.profiles
+    }
+
+    /// Draws the targets of one candidate.
+    pub(crate) fn sample_targets(
+        &self,
+        rng: &mut impl Rng,
+    ) -> std::result::Result<Targets, TargetUnavailable> {
+        match &self.targets {
+            TargetSampler::Copula(c) => {
+                let v = c.sample(rng);
+                Ok(Targets {
+                    aspect_ratio: v[0],
+                    min_dimension: v[1],
+                    flatness: v[2].max(v[0]),
+                    roundness: v[3],
+                    volume_surface_ratio: v[4],
+                })
+            }
+            TargetSampler::Seed {
+                ar_s,
+                s_vs,
+                flatness,
+                roundness,
+            } => {
+                let (ar, s) = ar_s.sample(rng);
+                let vs = s_vs
+                    .sample_y_given_x(s, 100_000, rng)
+                    .map_err(|_| TargetUnavailable)?;
+                Ok(Targets {
+                    aspect_ratio: ar,
+                    min_dimension: s,
+                    flatness: flatness.sample(rng).max(ar),
+                    roundness: roundness.sample(rng),
+                    volume_surface_ratio: vs,
+                })
+            }
+        }
+    }
+
+    /// Draws the normalised node radii of one candidate into `out`.
+    pub(crate) fn sample_radii(&self, rng: &mut impl Rng, out: &mut Vec<f64>) {
+        let n = self.geom.n_nodes();
+        out.clear();
+        match &self.radii {
+            RadiiSampler::Seed { marginals, weights } => {
+                for k in 0..n {
+                    let own = marginals[k].sample(rng);
+                    match self.geom.neighbours(k) {
+                        Some(nb) => {
+                            let w = weights[k];
+                            let mut s = own;
+                            let mut sw = 1.0;
+                            for (m, wm) in nb.iter().zip(w) {
+                                s += wm * marginals[*m].sample(rng);
+                                sw += wm;
+                            }
+                            out.push(s / sw);
+                        }
+                        None => out.push(own),
+                    }
+                }
+            }
+            RadiiSampler::Copula {
+                marginals,
+                factor,
+                parents,
+                noise,
+            } => {
+                let xi: Vec<f64> = (0..*parents).map(|_| StandardNormal.sample(rng)).collect();
+                out.resize(n, 0.0);
+                for (g, x) in xi.iter().enumerate() {
+                    let row = &factor[g * n..(g + 1) * n];
+                    for (o, f) in out.iter_mut().zip(row) {
+                        *o += x * f;
+                    }
+                }
+                for (k, o) in out.iter_mut().enumerate() {
+                    let e: f64 = StandardNormal.sample(rng);
+                    let z = *o + noise * e;
+                    *o = marginals[k].quantile(morph_dna::stats::normal_cdf(z));
+                }
+            }
+        }
+    }
+}
+
+/// The level set of a spherical-harmonic grain (e.g. a NIST/VCCTL scan): a
+/// cube of `resolution³` nodes spanning `±margin · r_max` about the model's
+/// centre, `r_max` from a 65 × 128 direction sample (the construction of
+/// `cargo xtask dna`).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a margin outside (1, 4]; SH evaluation
+/// errors ([`Error::DegenerateParent`] with index 0) and level-set errors.
+pub fn grid_from_sh(
+    model: &sph_harmonics::ShModel,
+    resolution: usize,
+    margin: f64,
+) -> Result<Grid> {
+    if !(margin.is_finite() && margin > 1.0 && margin <= 4.0) {
+        return Err(Error::InvalidParameter {
+            name: "margin",
+            value: margin,
+            reason: "in (1, 4]",
+        });
+    }
+    let sh = |e: sph_harmonics::Error| Error::DegenerateParent {
+        index: 0,
+        reason: e.to_string(),
+    };
+    let mut dirs = Vec::with_capacity(65 * 128);
+    for i in 0..=64 {
+        for j in 0..128 {
+            dirs.push((
+                std::f64::consts::PI * i as f64 / 64.0,
+                std::f64::consts::TAU * j as f64 / 128.0,
+            ));
+        }
+    }
+    let r_max = model
+        .evaluate(&dirs)
+        .map_err(sh)?
+        .into_iter()
+        .fold(0.0f64, f64::max);
+    let spec = levelset::GridSpec::cube(resolution, -margin * r_max, margin * r_max)?;
+    let radius = |u: nalgebra::Unit<nalgebra::Vector3<f64>>| {
+        let (theta, phi) = sph_harmonics::model::to_angles(&u.into_inner());
+        model.radius(theta, phi).unwrap_or(f64::NAN)
+    };
+    let (grid, _) = Grid::from_star(
+        spec,
+        &nalgebra::Point3::origin(),
+        radius,
+        &levelset::StarParams::default(),
+    )?;
+    Ok(grid)
+}

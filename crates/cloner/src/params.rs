@@ -1,0 +1,259 @@
+//! Parameters of a cloning run, validated once ([`Params::validate`]) and
+//! serialisable to RON (the calibrated configuration in
+//! `fixtures/calibrated/`).
+
+use serde::{Deserialize, Serialize};
+
+use morph_dna::SphericalMesh;
+
+use crate::error::{Error, Result};
+use crate::surface::Interpolation;
+
+/// How the clone's target DNA (aspect ratio, minimum principal dimension,
+/// flatness, roundness, volume/surface ratio) is drawn from the parents.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum TargetModel {
+    /// The seed (Medina 2018, §2.1–2.4): `(aspect ratio, S)` from the bicubic
+    /// interpolation of their 2D histogram by acceptance–rejection;
+    /// roundness and flatness from their 1D histograms (independent; the seed
+    /// does not say how the intermediate axis is chosen); the quality-control
+    /// volume/surface ratio from the `(S, V/S)` PDF conditional on `S`.
+    Seed,
+    /// A Gaussian copula over the parents' empirical marginals of all five
+    /// (`morph_dna::GaussianCopula`): every pairwise correlation kept, not
+    /// only the two "high enough" ones; the quality-control V/S is drawn
+    /// conditional on the other four. Default.
+    #[default]
+    Copula,
+}
+
+/// How the radii of the mesh nodes are drawn (normalised by the embryo
+/// ellipsoid's radius in the node's direction).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum RadiiModel {
+    /// The seed (Medina 2018, §2.3): for every node, one draw from its own
+    /// histogram and one from each stencil neighbour's, averaged with the
+    /// parents' node-neighbour correlations as weights (self weight 1,
+    /// negative correlations count as 0).
+    SeedNeighbourhood,
+    /// A Gaussian-copula random field: normal scores of the parents' node
+    /// radii, whose full node-node correlation (shrunk towards the identity
+    /// by `shrinkage` so it is positive definite) is sampled through the
+    /// low-rank parent factor, mapped through every node's own histogram.
+    /// Per-node marginals and all spatial correlations are kept (the seed's
+    /// average of independent draws narrows both). Default.
+    CopulaField {
+        /// Weight of the identity in the correlation, in [0, 1).
+        shrinkage: f64,
+    },
+}
+
+impl Default for RadiiModel {
+    fn default() -> Self {
+        Self::CopulaField { shrinkage: 0.05 }
+    }
+}
+
+/// The Laplacian polishing that raises roundness to the sampled value.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Smoothing {
+    /// Umbrella-operator step λ in (0, 1].
+    pub lambda: f64,
+    /// Iterations after which a candidate that is still too sharp is
+    /// rejected (≥ 1).
+    pub max_iterations: usize,
+}
+
+impl Default for Smoothing {
+    fn default() -> Self {
+        Self {
+            lambda: 0.5,
+            max_iterations: 64,
+        }
+    }
+}
+
+/// What a run returns besides the clones' mesh radii and targets. Nothing is
+/// computed for an output nobody asked for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Outputs {
+    /// Keep each clone's level set (`levelset::Grid`).
+    pub level_set: bool,
+    /// Measure each clone's DNA on its level set (builds the level set).
+    pub dna: bool,
+}
+
+impl Default for Outputs {
+    fn default() -> Self {
+        Self {
+            level_set: false,
+            dna: true,
+        }
+    }
+}
+
+/// Parameters of GSC 2.0 cloning. Defaults are the seed's trial 4 (mesh
+/// 28 × (18 + 2), 50 bins, 45³, 1 % tolerance) with this crate's default
+/// methods; [`Params::seed_faithful`] switches every method to the seed's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Params {
+    /// The spherical mesh of the radii.
+    pub mesh: SphericalMesh,
+    /// Histogram bins (per axis for 2D histograms; per node for radii).
+    pub bins: usize,
+    /// Level-set nodes per axis of the rasterised clone.
+    pub level_set_resolution: usize,
+    /// Half-width of the clone's grid cube over its largest radius (> 1).
+    pub grid_margin: f64,
+    /// Relative tolerance of the volume/surface-ratio quality control.
+    pub tolerance: f64,
+    /// Laplacian polishing.
+    pub smoothing: Smoothing,
+    /// Target DNA model.
+    pub targets: TargetModel,
+    /// Radii model.
+    pub radii: RadiiModel,
+    /// Radius interpolation between nodes.
+    pub interpolation: Interpolation,
+    /// Fixed-point corrections of the embryo's semi-axes after polishing so
+    /// that the surface's principal dimensions meet the sampled ones (0 = the
+    /// seed, which keeps the embryo's axes).
+    pub axis_corrections: usize,
+    /// Candidates per clone index before [`Error::TooManyRejections`].
+    pub max_attempts: usize,
+    /// Master seed; clone `i` uses the stream `(seed, i)`.
+    pub seed: u64,
+    /// Outputs to produce.
+    pub outputs: Outputs,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Self {
+            mesh: SphericalMesh::default(),
+            bins: 50,
+            level_set_resolution: 45,
+            grid_margin: 1.1,
+            tolerance: 0.01,
+            smoothing: Smoothing::default(),
+            targets: TargetModel::default(),
+            radii: RadiiModel::default(),
+            interpolation: Interpolation::default(),
+            axis_corrections: 2,
+            max_attempts: 20_000,
+            seed: 2018,
+            outputs: Outputs::default(),
+        }
+    }
+}
+
+impl Params {
+    /// The seed's methods at its trial-4 configuration: pairwise histogram
+    /// PDFs, neighbourhood-averaged radii, bilinear interpolation, no axis
+    /// correction.
+    pub fn seed_faithful() -> Self {
+        Self {
+            targets: TargetModel::Seed,
+            radii: RadiiModel::SeedNeighbourhood,
+            interpolation: Interpolation::Bilinear,
+            axis_corrections: 0,
+            ..Self::default()
+        }
+    }
+
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`Error::MeshTooCoarse`] for a mesh below `4 × (2 + 2)`,
+    /// [`Error::InvalidParameter`] for any other field out of its domain.
+    pub fn validate(&self) -> Result<()> {
+        if self.mesh.n_az < 4 || self.mesh.n_pol < 2 {
+            return Err(Error::MeshTooCoarse {
+                n_az: self.mesh.n_az,
+                n_pol: self.mesh.n_pol,
+            });
+        }
+        let bad = |name, value: f64, reason| {
+            Err(Error::InvalidParameter {
+                name,
+                value,
+                reason,
+            })
+        };
+        if self.mesh.n_az > 4096 || self.mesh.n_pol > 4096 {
+            return bad(
+                "mesh",
+                self.mesh.n_az.max(self.mesh.n_pol) as f64,
+                "at most 4096 divisions per direction",
+            );
+        }
+        if !(2..=10_000).contains(&self.bins) {
+            return bad("bins", self.bins as f64, "between 2 and 10000");
+        }
+        if !(8..=1024).contains(&self.level_set_resolution) {
+            return bad(
+                "level_set_resolution",
+                self.level_set_resolution as f64,
+                "between 8 and 1024 nodes per axis",
+            );
+        }
+        if !(self.grid_margin.is_finite() && self.grid_margin > 1.0 && self.grid_margin <= 4.0) {
+            return bad("grid_margin", self.grid_margin, "in (1, 4]");
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return bad("tolerance", self.tolerance, "in (0, 1)");
+        }
+        let s = self.smoothing;
+        if !(s.lambda.is_finite() && s.lambda > 0.0 && s.lambda <= 1.0) {
+            return bad("smoothing.lambda", s.lambda, "in (0, 1]");
+        }
+        if !(1..=100_000).contains(&s.max_iterations) {
+            return bad(
+                "smoothing.max_iterations",
+                s.max_iterations as f64,
+                "between 1 and 100000",
+            );
+        }
+        if let RadiiModel::CopulaField { shrinkage } = self.radii
+            && !(shrinkage.is_finite() && (0.0..1.0).contains(&shrinkage))
+        {
+            return bad("radii.shrinkage", shrinkage, "in [0, 1)");
+        }
+        if self.axis_corrections > 100 {
+            return bad(
+                "axis_corrections",
+                self.axis_corrections as f64,
+                "at most 100",
+            );
+        }
+        if self.max_attempts == 0 {
+            return bad("max_attempts", 0.0, "at least 1");
+        }
+        Ok(())
+    }
+
+    /// The parameters as pretty RON.
+    ///
+    /// # Errors
+    /// [`Error::Ron`] (cannot happen for these plain fields).
+    pub fn to_ron(&self) -> Result<String> {
+        ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default()).map_err(|e| {
+            Error::Ron {
+                message: e.to_string(),
+            }
+        })
+    }
+
+    /// Parses and validates RON parameters.
+    ///
+    /// # Errors
+    /// [`Error::Ron`] for malformed text (with its position), and those of
+    /// [`Params::validate`].
+    pub fn from_ron(text: &str) -> Result<Self> {
+        let p: Self = ron::from_str(text).map_err(|e| Error::Ron {
+            message: e.to_string(),
+        })?;
+        p.validate()?;
+        Ok(p)
+    }
+}

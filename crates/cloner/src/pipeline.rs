@@ -1,0 +1,569 @@
+//! The cloning pipeline (Medina 2018, §2.2–2.5), one function per stage, and
+//! the parallel, deterministic driver.
+//!
+//! A candidate for clone index `i` runs, on the random stream `(seed, i)`:
+//!
+//! 1. **targets** — aspect ratio, `S`, flatness, roundness and the
+//!    quality-control V/S from the population model ([`crate::TargetModel`]);
+//!    the embryo is the ellipsoid with semi-axes `(L, I, S)/2`;
+//! 2. **radii** — normalised node radii `ρ` ([`crate::RadiiModel`]); the
+//!    candidate's radii are `r = r_ellipsoid · ρ`;
+//! 3. **polishing** — umbrella-Laplacian steps on `ρ` until the surface
+//!    roundness reaches the target (the last step is interpolated so the
+//!    target is met, not overshot); rejected at once if the raw candidate is
+//!    already rounder than the target (smoothing only rounds), or after
+//!    `max_iterations`;
+//! 4. **quality control** — optional fixed-point corrections of the embryo
+//!    axes so the surface's principal dimensions meet the targets, then the
+//!    V/S test `|V/S − V/S*| ≤ tol · V/S*` (Medina 2018, §2.4);
+//! 5. **rasterisation** of accepted candidates (only if a level set or DNA
+//!    was asked for) through `levelset::Grid::from_star`;
+//! 6. **DNA** of the level set through `morph_dna::measure` (only if asked
+//!    for).
+//!
+//! Candidates are rejected in this order, so a rejection costs only the
+//! stages before it. The library reads no clock: stage times come from the
+//! caller's [`Clock`].
+
+use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use levelset::{Grid, GridSpec, StarParams};
+use morph_dna::{DnaTable, MeasureParams, measure};
+use nalgebra::Point3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::model::{CloneModel, DNA, Targets};
+use crate::surface::SurfaceDna;
+
+/// A monotonic clock supplied by the caller (the library reads none).
+pub trait Clock: Sync {
+    /// Nanoseconds since an arbitrary fixed origin.
+    fn now_ns(&self) -> u64;
+}
+
+/// A clock that always reads 0 (no timings).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoClock;
+
+impl Clock for NoClock {
+    fn now_ns(&self) -> u64 {
+        0
+    }
+}
+
+/// Progress of a run, passed to the caller's callback after every finished
+/// clone index (from worker threads, in completion order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Progress {
+    /// Clone indices finished so far.
+    pub done: u64,
+    /// Clone indices of the run.
+    pub total: u64,
+}
+
+/// Callbacks and clock of a run.
+#[derive(Clone, Copy)]
+pub struct Hooks<'a> {
+    /// Stage timings come from this clock.
+    pub clock: &'a dyn Clock,
+    /// Called after every finished clone index.
+    pub progress: Option<&'a (dyn Fn(Progress) + Sync)>,
+}
+
+impl std::fmt::Debug for Hooks<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Hooks")
+            .field("progress", &self.progress.is_some())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Default for Hooks<'_> {
+    fn default() -> Self {
+        Self {
+            clock: &NoClock,
+            progress: None,
+        }
+    }
+}
+
+/// Why candidates were rejected (counts).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct Rejections {
+    /// The target draw failed (a conditional slice without mass).
+    pub target_unavailable: u64,
+    /// The raw candidate was already rounder than its target.
+    pub too_round: u64,
+    /// Polishing did not reach the target within `max_iterations`.
+    pub roundness_unreached: u64,
+    /// A degenerate surface or level set.
+    pub degenerate: u64,
+    /// The V/S quality control.
+    pub quality_control: u64,
+}
+
+impl Rejections {
+    /// All rejections.
+    pub fn total(&self) -> u64 {
+        self.target_unavailable
+            + self.too_round
+            + self.roundness_unreached
+            + self.degenerate
+            + self.quality_control
+    }
+
+    fn add(&mut self, o: &Self) {
+        self.target_unavailable += o.target_unavailable;
+        self.too_round += o.too_round;
+        self.roundness_unreached += o.roundness_unreached;
+        self.degenerate += o.degenerate;
+        self.quality_control += o.quality_control;
+    }
+}
+
+/// Time spent per stage, summed over threads, in nanoseconds (all zero with
+/// [`NoClock`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct StageTimes {
+    /// Target draws.
+    pub targets_ns: u64,
+    /// Radii draws.
+    pub radii_ns: u64,
+    /// Laplacian polishing.
+    pub polishing_ns: u64,
+    /// Axis correction and quality control.
+    pub quality_ns: u64,
+    /// Level-set rasterisation.
+    pub rasterise_ns: u64,
+    /// DNA measurement of the level set.
+    pub measure_ns: u64,
+}
+
+impl StageTimes {
+    /// Sum of all stages.
+    pub fn total_ns(&self) -> u64 {
+        self.targets_ns
+            + self.radii_ns
+            + self.polishing_ns
+            + self.quality_ns
+            + self.rasterise_ns
+            + self.measure_ns
+    }
+
+    fn add(&mut self, o: &Self) {
+        self.targets_ns += o.targets_ns;
+        self.radii_ns += o.radii_ns;
+        self.polishing_ns += o.polishing_ns;
+        self.quality_ns += o.quality_ns;
+        self.rasterise_ns += o.rasterise_ns;
+        self.measure_ns += o.measure_ns;
+    }
+}
+
+/// Statistics of a run (or of one clone).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct RunStats {
+    /// Accepted clones.
+    pub accepted: u64,
+    /// Candidates drawn.
+    pub attempts: u64,
+    /// Rejected candidates by reason.
+    pub rejections: Rejections,
+    /// Laplacian steps over all candidates.
+    pub polishing_steps: u64,
+    /// Stage times.
+    pub times: StageTimes,
+}
+
+impl RunStats {
+    /// Accepted over attempted candidates.
+    pub fn acceptance_rate(&self) -> f64 {
+        if self.attempts == 0 {
+            0.0
+        } else {
+            self.accepted as f64 / self.attempts as f64
+        }
+    }
+
+    fn add(&mut self, o: &Self) {
+        self.accepted += o.accepted;
+        self.attempts += o.attempts;
+        self.rejections.add(&o.rejections);
+        self.polishing_steps += o.polishing_steps;
+        self.times.add(&o.times);
+    }
+}
+
+/// One accepted clone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClonedGrain {
+    /// Clone index (its random stream).
+    pub index: u64,
+    /// Candidates drawn for this index.
+    pub attempts: usize,
+    /// Radii at the mesh nodes (flat order of `morph_dna::SphericalMesh`),
+    /// in the clone's frame: major axis +x, minor axis +z, centre at the
+    /// origin.
+    pub radii: Vec<f64>,
+    /// The sampled targets.
+    pub targets: Targets,
+    /// Surface DNA of the accepted radii.
+    pub surface: SurfaceDna,
+    /// The clone's level set, if [`crate::Outputs::level_set`].
+    pub grid: Option<Grid>,
+    /// The clone's [`DNA`] measured on its level set, if
+    /// [`crate::Outputs::dna`].
+    pub dna: Option<Vec<f64>>,
+}
+
+/// The result of [`CloneModel::run`].
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// Accepted clones in index order.
+    pub clones: Vec<ClonedGrain>,
+    /// Totals over the run.
+    pub stats: RunStats,
+}
+
+impl Run {
+    /// The clones' measured [`DNA`] as a table.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] if the run did not measure DNA; table
+    /// errors.
+    pub fn dna_table(&self) -> Result<DnaTable> {
+        let mut t = DnaTable::new(DNA.to_vec())?;
+        for c in &self.clones {
+            let Some(d) = &c.dna else {
+                return Err(Error::InvalidParameter {
+                    name: "outputs.dna",
+                    value: 0.0,
+                    reason: "the run must measure DNA for a DNA table",
+                });
+            };
+            t.push_row(d)?;
+        }
+        Ok(t)
+    }
+}
+
+/// The index range of shard `k` of `n` (1-based) of `0..total`: contiguous,
+/// the first `total mod n` shards one longer. Shards together are exactly
+/// `0..total`, so a sharded run equals the unsharded one.
+///
+/// # Errors
+/// [`Error::InvalidShard`].
+pub fn shard_range(total: u64, k: u64, n: u64) -> Result<Range<u64>> {
+    if n == 0 || k == 0 || k > n {
+        return Err(Error::InvalidShard { k, n });
+    }
+    let base = total / n;
+    let extra = total % n;
+    let start = (k - 1) * base + (k - 1).min(extra);
+    let len = base + u64::from(k <= extra);
+    Ok(start..start + len)
+}
+
+/// The random stream of clone `index`: ChaCha8 seeded with `seed`, stream
+/// `index` (portable and independent of thread count and sharding).
+pub fn clone_rng(seed: u64, index: u64) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(index);
+    rng
+}
+
+enum Reject {
+    TargetUnavailable,
+    TooRound,
+    RoundnessUnreached,
+    Degenerate,
+    QualityControl,
+}
+
+struct Candidate {
+    radii: Vec<f64>,
+    targets: Targets,
+    surface: SurfaceDna,
+}
+
+struct Scratch {
+    rho: Vec<f64>,
+    prev: Vec<f64>,
+    next: Vec<f64>,
+    r_ell: Vec<f64>,
+    r: Vec<f64>,
+}
+
+impl CloneModel {
+    fn radii_from(&self, r_ell: &[f64], rho: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(r_ell.iter().zip(rho).map(|(a, b)| a * b));
+    }
+
+    fn ellipsoid(&self, semi: [f64; 3], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend((0..self.geom.n_nodes()).map(|k| self.geom.ellipsoid_radius(k, semi)));
+    }
+
+    /// Stages 1–4 for one candidate.
+    fn candidate(
+        &self,
+        rng: &mut ChaCha8Rng,
+        s: &mut Scratch,
+        stats: &mut RunStats,
+        clock: &dyn Clock,
+    ) -> std::result::Result<Candidate, Reject> {
+        let p = &self.params;
+        let (res, margin) = (p.level_set_resolution, p.grid_margin);
+        let t0 = clock.now_ns();
+        let targets = self
+            .sample_targets(rng)
+            .map_err(|_| Reject::TargetUnavailable)?;
+        let semi = targets.semi_axes();
+        self.ellipsoid(semi, &mut s.r_ell);
+        let t1 = clock.now_ns();
+        stats.times.targets_ns += t1 - t0;
+        self.sample_radii(rng, &mut s.rho);
+        let t2 = clock.now_ns();
+        stats.times.radii_ns += t2 - t1;
+        // polishing
+        let goal = targets.roundness;
+        self.radii_from(&s.r_ell, &s.rho, &mut s.r);
+        let mut r_prev = self.geom.roundness(&s.r, res, margin);
+        let polished = if r_prev > goal {
+            Err(Reject::TooRound)
+        } else {
+            let mut reached = r_prev >= goal;
+            s.prev.clone_from(&s.rho);
+            let mut k = 0;
+            while !reached && k < p.smoothing.max_iterations {
+                s.next.resize(s.prev.len(), 0.0);
+                self.geom
+                    .smooth_into(&s.prev, p.smoothing.lambda, &mut s.next);
+                stats.polishing_steps += 1;
+                k += 1;
+                self.radii_from(&s.r_ell, &s.next, &mut s.r);
+                let r_next = self.geom.roundness(&s.r, res, margin);
+                if r_next >= goal {
+                    let alpha = if r_next > r_prev {
+                        ((goal - r_prev) / (r_next - r_prev)).clamp(0.0, 1.0)
+                    } else {
+                        1.0
+                    };
+                    for ((o, a), b) in s.rho.iter_mut().zip(&s.prev).zip(&s.next) {
+                        *o = a + alpha * (b - a);
+                    }
+                    reached = true;
+                } else {
+                    std::mem::swap(&mut s.prev, &mut s.next);
+                    r_prev = r_next;
+                }
+            }
+            if reached {
+                Ok(())
+            } else {
+                Err(Reject::RoundnessUnreached)
+            }
+        };
+        let t3 = clock.now_ns();
+        stats.times.polishing_ns += t3 - t2;
+        polished?;
+        // axis correction and quality control
+        let result = (|| {
+            self.radii_from(&s.r_ell, &s.rho, &mut s.r);
+            let mut surf = self
+                .geom
+                .surface_dna(&s.r, res, margin)
+                .ok_or(Reject::Degenerate)?;
+            let goal_dims = [2.0 * semi[0], 2.0 * semi[1], 2.0 * semi[2]];
+            let mut semi_c = semi;
+            for _ in 0..p.axis_corrections {
+                for a in 0..3 {
+                    semi_c[a] *= goal_dims[a] / surf.dims[a];
+                }
+                self.ellipsoid(semi_c, &mut s.r_ell);
+                self.radii_from(&s.r_ell, &s.rho, &mut s.r);
+                surf = self
+                    .geom
+                    .surface_dna(&s.r, res, margin)
+                    .ok_or(Reject::Degenerate)?;
+            }
+            let vs = surf.volume_surface_ratio();
+            let want = targets.volume_surface_ratio;
+            if (vs - want).abs() > p.tolerance * want {
+                return Err(Reject::QualityControl);
+            }
+            Ok(Candidate {
+                radii: s.r.clone(),
+                targets,
+                surface: surf,
+            })
+        })();
+        stats.times.quality_ns += clock.now_ns() - t3;
+        result
+    }
+
+    /// The level set of node radii `radii` at the model's resolution: a cube
+    /// of `level_set_resolution³` nodes spanning `±grid_margin · max r` about
+    /// the origin.
+    ///
+    /// # Errors
+    /// Level-set construction errors.
+    pub fn rasterise(&self, radii: &[f64]) -> Result<Grid> {
+        self.rasterise_at(radii, self.params.level_set_resolution)
+    }
+
+    /// As [`CloneModel::rasterise`] at another resolution.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a radii vector of the wrong length or
+    /// with a non-positive entry; level-set construction errors.
+    pub fn rasterise_at(&self, radii: &[f64], resolution: usize) -> Result<Grid> {
+        if radii.len() != self.geom.n_nodes() {
+            return Err(Error::InvalidParameter {
+                name: "radii",
+                value: radii.len() as f64,
+                reason: "one radius per mesh node",
+            });
+        }
+        if let Some(bad) = radii.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+            return Err(Error::InvalidParameter {
+                name: "radii",
+                value: *bad,
+                reason: "finite and positive",
+            });
+        }
+        let r_max = radii.iter().fold(0.0f64, |a, b| a.max(*b));
+        let half = self.params.grid_margin * r_max;
+        let spec = GridSpec::cube(resolution, -half, half)?;
+        let (grid, _) = Grid::from_star(
+            spec,
+            &Point3::origin(),
+            self.geom.radius_fn(radii, self.params.interpolation),
+            &StarParams::default(),
+        )?;
+        Ok(grid)
+    }
+
+    /// Clone `index`: candidates on the stream `(seed, index)` until one is
+    /// accepted.
+    ///
+    /// # Errors
+    /// [`Error::TooManyRejections`] after `max_attempts` candidates.
+    pub fn clone_one(&self, index: u64, clock: &dyn Clock) -> Result<(ClonedGrain, RunStats)> {
+        let mut rng = clone_rng(self.params.seed, index);
+        let mut stats = RunStats::default();
+        let mut s = Scratch {
+            rho: Vec::new(),
+            prev: Vec::new(),
+            next: Vec::new(),
+            r_ell: Vec::new(),
+            r: Vec::new(),
+        };
+        let outputs = self.params.outputs;
+        for attempt in 1..=self.params.max_attempts {
+            stats.attempts += 1;
+            let cand = match self.candidate(&mut rng, &mut s, &mut stats, clock) {
+                Ok(c) => c,
+                Err(r) => {
+                    let rj = &mut stats.rejections;
+                    match r {
+                        Reject::TargetUnavailable => rj.target_unavailable += 1,
+                        Reject::TooRound => rj.too_round += 1,
+                        Reject::RoundnessUnreached => rj.roundness_unreached += 1,
+                        Reject::Degenerate => rj.degenerate += 1,
+                        Reject::QualityControl => rj.quality_control += 1,
+                    }
+                    continue;
+                }
+            };
+            let (mut grid, mut dna) = (None, None);
+            if outputs.level_set || outputs.dna {
+                let t0 = clock.now_ns();
+                let g = self.rasterise(&cand.radii);
+                let t1 = clock.now_ns();
+                stats.times.rasterise_ns += t1 - t0;
+                let Ok(g) = g else {
+                    stats.rejections.degenerate += 1;
+                    continue;
+                };
+                if outputs.dna {
+                    let d = measure(&g, &DNA, &MeasureParams::default());
+                    stats.times.measure_ns += clock.now_ns() - t1;
+                    match d {
+                        Ok(d) => dna = Some(d),
+                        Err(_) => {
+                            stats.rejections.degenerate += 1;
+                            continue;
+                        }
+                    }
+                }
+                if outputs.level_set {
+                    grid = Some(g);
+                }
+            }
+            stats.accepted += 1;
+            return Ok((
+                ClonedGrain {
+                    index,
+                    attempts: attempt,
+                    radii: cand.radii,
+                    targets: cand.targets,
+                    surface: cand.surface,
+                    grid,
+                    dna,
+                },
+                stats,
+            ));
+        }
+        Err(Error::TooManyRejections {
+            index,
+            attempts: self.params.max_attempts,
+        })
+    }
+
+    /// Clones every index of `range` in parallel (rayon's current pool). The
+    /// clones, and every statistic except the stage times, are identical for
+    /// any thread count and any split of the range.
+    ///
+    /// # Errors
+    /// [`Error::InvalidRange`] for an empty or reversed range, and the first
+    /// (lowest-index) error of [`CloneModel::clone_one`].
+    pub fn run(&self, range: Range<u64>, hooks: Hooks<'_>) -> Result<Run> {
+        if range.start >= range.end {
+            return Err(Error::InvalidRange {
+                start: range.start,
+                end: range.end,
+            });
+        }
+        let total = range.end - range.start;
+        let done = AtomicU64::new(0);
+        let results: Vec<Result<(ClonedGrain, RunStats)>> = range
+            .into_par_iter()
+            .map(|i| {
+                let r = self.clone_one(i, hooks.clock);
+                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if let Some(cb) = hooks.progress {
+                    cb(Progress { done: d, total });
+                }
+                r
+            })
+            .collect();
+        let mut clones = Vec::with_capacity(results.len());
+        let mut stats = RunStats::default();
+        for r in results {
+            let (c, s) = r?;
+            stats.add(&s);
+            clones.push(c);
+        }
+        Ok(Run { clones, stats })
+    }
+}
+
+#[cfg(test)]
+mod tests;
