@@ -5,34 +5,110 @@ use nalgebra::{Point3, Vector3};
 
 use crate::error::{Error, Result};
 
+/// No point / no face.
+const NONE: u32 = u32::MAX;
+
+/// A face of the hull under construction. Slots of deleted faces are
+/// reused; `generation` tells a stale work-list entry from the slot's
+/// current face.
+#[derive(Clone, Copy)]
 struct Face {
-    v: [usize; 3],
+    v: [u32; 3],
     /// `nb[k]`: the face across edge `(v[k], v[k+1])`.
-    nb: [usize; 3],
-    normal: Vector3<f64>,
-    offset: f64,
-    outside: Vec<usize>,
+    nb: [u32; 3],
+    /// Conflict list (points outside this face, in assignment order) as a
+    /// singly linked list through `Faces::next`.
+    head: u32,
+    tail: u32,
+    /// The farthest point of the conflict list (the last of equals).
+    far: u32,
+    generation: u32,
+    far_d: f64,
     alive: bool,
 }
 
-impl Face {
-    fn new(points: &[Point3<f64>], v: [usize; 3]) -> Self {
-        let (a, b, c) = (points[v[0]], points[v[1]], points[v[2]]);
+/// Plane of a face: unit normal and offset (`n·x = offset`).
+#[derive(Clone, Copy)]
+struct Plane {
+    normal: Vector3<f64>,
+    offset: f64,
+}
+
+impl Plane {
+    #[inline]
+    fn new(points: &[Point3<f64>], v: [u32; 3]) -> Self {
+        let (a, b, c) = (
+            points[v[0] as usize],
+            points[v[1] as usize],
+            points[v[2] as usize],
+        );
         let n = (b - a).cross(&(c - a));
         let len = n.norm();
         let normal = if len > 0.0 { n / len } else { Vector3::zeros() };
         Self {
-            v,
-            nb: [usize::MAX; 3],
             normal,
             offset: normal.dot(&a.coords),
-            outside: Vec::new(),
-            alive: true,
         }
     }
 
+    #[inline]
     fn distance(&self, p: &Point3<f64>) -> f64 {
         self.normal.dot(&p.coords) - self.offset
+    }
+}
+
+/// Faces and their planes (apart, so that distance tests read a dense
+/// array), the conflict-list links of the points and the free slots.
+struct Faces {
+    faces: Vec<Face>,
+    planes: Vec<Plane>,
+    /// Per point: the next point of the same conflict list.
+    next: Vec<u32>,
+    free: Vec<u32>,
+}
+
+impl Faces {
+    fn push(&mut self, points: &[Point3<f64>], v: [u32; 3]) -> u32 {
+        let plane = Plane::new(points, v);
+        let mut face = Face {
+            v,
+            nb: [NONE; 3],
+            head: NONE,
+            tail: NONE,
+            far: NONE,
+            generation: 0,
+            far_d: f64::NEG_INFINITY,
+            alive: true,
+        };
+        if let Some(id) = self.free.pop() {
+            let slot = id as usize;
+            face.generation = self.faces[slot].generation.wrapping_add(1);
+            self.faces[slot] = face;
+            self.planes[slot] = plane;
+            id
+        } else {
+            self.faces.push(face);
+            self.planes.push(plane);
+            (self.faces.len() - 1) as u32
+        }
+    }
+
+    /// Appends point `p` at distance `d` to the conflict list of face `f`.
+    #[inline]
+    fn assign(&mut self, f: u32, p: u32, d: f64) {
+        self.next[p as usize] = NONE;
+        let face = &mut self.faces[f as usize];
+        if face.tail == NONE {
+            face.head = p;
+        } else {
+            self.next[face.tail as usize] = p;
+        }
+        face.tail = p;
+        // `max_by` semantics: the last of equal maxima wins
+        if d >= face.far_d {
+            face.far_d = d;
+            face.far = p;
+        }
     }
 }
 
@@ -71,6 +147,9 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
     };
     if points.len() < 4 {
         return Err(degenerate("at least 4 points are needed"));
+    }
+    if u32::try_from(points.len()).is_err() {
+        return Err(degenerate("at most 2^32 - 1 points"));
     }
     if points
         .iter()
@@ -127,22 +206,31 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
     if h.abs() <= eps * 1e3 {
         return Err(degenerate("points are coplanar"));
     }
-    let mut faces: Vec<Face> = Vec::new();
+    // a closed triangulation of n points has 2n − 4 faces
+    let cap = 2 * points.len().min(1 << 20) + 64;
+    let mut fs = Faces {
+        faces: Vec::with_capacity(cap),
+        planes: Vec::with_capacity(cap),
+        next: vec![NONE; points.len()],
+        free: Vec::new(),
+    };
     let tet = if h > 0.0 {
         [[i0, i2, i1], [i0, i1, i3], [i1, i2, i3], [i2, i0, i3]]
     } else {
         [[i0, i1, i2], [i0, i3, i1], [i1, i3, i2], [i2, i3, i0]]
     };
     for v in tet {
-        faces.push(Face::new(points, v));
+        fs.push(points, v.map(|i| i as u32));
     }
     // adjacency of the tetrahedron
     for f in 0..4 {
         for k in 0..3 {
-            let (a, b) = (faces[f].v[k], faces[f].v[(k + 1) % 3]);
-            let twin = (0..4)
-                .find(|&g| (0..3).any(|j| faces[g].v[j] == b && faces[g].v[(j + 1) % 3] == a));
-            faces[f].nb[k] = twin.ok_or_else(|| degenerate("inconsistent initial tetrahedron"))?;
+            let (a, b) = (fs.faces[f].v[k], fs.faces[f].v[(k + 1) % 3]);
+            let twin = (0..4).find(|&g| {
+                (0..3).any(|j| fs.faces[g].v[j] == b && fs.faces[g].v[(j + 1) % 3] == a)
+            });
+            fs.faces[f].nb[k] =
+                twin.ok_or_else(|| degenerate("inconsistent initial tetrahedron"))? as u32;
         }
     }
     let used = [i0, i1, i2, i3];
@@ -150,101 +238,141 @@ pub fn convex_hull(points: &[Point3<f64>]) -> Result<Vec<[usize; 3]>> {
         if used.contains(&p) {
             continue;
         }
-        if let Some(f) = faces.iter_mut().find(|f| f.distance(pt) > eps) {
-            f.outside.push(p);
+        for f in 0..4 {
+            let d = fs.planes[f].distance(pt);
+            if d > eps {
+                fs.assign(f as u32, p as u32, d);
+                break;
+            }
         }
     }
     // visibility memo per iteration: stamp[f] == iteration ⇒ visible[f] valid
     let mut stamp: Vec<usize> = Vec::new();
     let mut seen_visible: Vec<bool> = Vec::new();
     let mut in_region: Vec<bool> = Vec::new();
-    // work list of faces that may have outside points (LIFO, deterministic)
-    let mut pending: Vec<usize> = (0..faces.len()).collect();
+    // horizon fan links: per point, the iteration that set it and the index
+    // of the first horizon edge starting / ending there
+    let mut start_stamp: Vec<usize> = vec![0; points.len()];
+    let mut starts_at: Vec<u32> = vec![0; points.len()];
+    let mut end_stamp: Vec<usize> = vec![0; points.len()];
+    let mut ends_at: Vec<u32> = vec![0; points.len()];
+    let mut visible: Vec<u32> = Vec::new();
+    // (a, b, face across) for each horizon edge
+    let mut horizon: Vec<(u32, u32, u32)> = Vec::new();
+    let mut new_faces: Vec<u32> = Vec::new();
+    // work list of faces that may have outside points (LIFO, deterministic):
+    // (slot, generation)
+    let mut pending: Vec<(u32, u32)> = (0..4).map(|f| (f, 0)).collect();
     let mut iteration = 0usize;
-    while let Some(fi) = pending.pop() {
-        if !faces[fi].alive || faces[fi].outside.is_empty() {
+    while let Some((fi, generation)) = pending.pop() {
+        let face = fs.faces[fi as usize];
+        if face.generation != generation || !face.alive || face.head == NONE {
             continue;
         }
         iteration += 1;
-        let eye = *faces[fi]
-            .outside
-            .iter()
-            .max_by(|&&a, &&b| {
-                faces[fi]
-                    .distance(&points[a])
-                    .total_cmp(&faces[fi].distance(&points[b]))
-            })
-            .unwrap_or(&faces[fi].outside[0]);
-        let ep = points[eye];
+        let eye = face.far;
+        let ep = points[eye as usize];
         // visible region: connected faces seen from the eye, walked over the
         // adjacency from the face the eye was chosen from; the horizon is
         // where the walk meets a face that is not visible
-        stamp.resize(faces.len(), 0);
-        seen_visible.resize(faces.len(), false);
-        in_region.resize(faces.len(), false);
-        in_region[fi] = true;
-        let mut visible = vec![fi];
-        // (a, b, face across) for each horizon edge
-        let mut horizon: Vec<(usize, usize, usize)> = Vec::new();
+        let nf = fs.faces.len();
+        stamp.resize(nf, 0);
+        seen_visible.resize(nf, false);
+        in_region.resize(nf, false);
+        in_region[fi as usize] = true;
+        visible.clear();
+        visible.push(fi);
+        horizon.clear();
         let mut cur = 0;
         while cur < visible.len() {
-            let f = visible[cur];
+            let f = visible[cur] as usize;
             cur += 1;
             for k in 0..3 {
-                let nb = faces[f].nb[k];
-                if stamp[nb] != iteration {
-                    stamp[nb] = iteration;
-                    seen_visible[nb] = in_region[nb] || faces[nb].distance(&ep) > eps;
+                let nb = fs.faces[f].nb[k];
+                let n = nb as usize;
+                if stamp[n] != iteration {
+                    stamp[n] = iteration;
+                    seen_visible[n] = in_region[n] || fs.planes[n].distance(&ep) > eps;
                 }
-                if seen_visible[nb] {
-                    if !in_region[nb] {
-                        in_region[nb] = true;
+                if seen_visible[n] {
+                    if !in_region[n] {
+                        in_region[n] = true;
                         visible.push(nb);
                     }
                 } else {
-                    horizon.push((faces[f].v[k], faces[f].v[(k + 1) % 3], nb));
+                    let v = fs.faces[f].v;
+                    horizon.push((v[k], v[(k + 1) % 3], nb));
                 }
             }
         }
-        let mut orphans = Vec::new();
         for &i in &visible {
-            in_region[i] = false;
-            faces[i].alive = false;
-            orphans.append(&mut faces[i].outside);
+            in_region[i as usize] = false;
+            fs.faces[i as usize].alive = false;
         }
-        let first_new = faces.len();
-        for &(a, b, across) in &horizon {
-            let id = faces.len();
-            let mut face = Face::new(points, [a, b, eye]);
-            face.nb[0] = across;
+        // new faces take slots freed by earlier iterations, so the conflict
+        // lists of this iteration's visible faces stay readable
+        new_faces.clear();
+        for (e, &(a, b, across)) in horizon.iter().enumerate() {
+            let id = fs.push(points, [a, b, eye]);
+            fs.faces[id as usize].nb[0] = across;
+            let acr = &mut fs.faces[across as usize];
             let k = (0..3)
-                .find(|&j| faces[across].v[j] == b && faces[across].v[(j + 1) % 3] == a)
+                .find(|&j| acr.v[j] == b && acr.v[(j + 1) % 3] == a)
                 .ok_or_else(|| degenerate("numerically degenerate point set"))?;
-            faces[across].nb[k] = id;
-            faces.push(face);
+            acr.nb[k] = id;
+            new_faces.push(id);
+            // the first horizon edge starting / ending at a point wins
+            if start_stamp[a as usize] != iteration {
+                start_stamp[a as usize] = iteration;
+                starts_at[a as usize] = e as u32;
+            }
+            if end_stamp[b as usize] != iteration {
+                end_stamp[b as usize] = iteration;
+                ends_at[b as usize] = e as u32;
+            }
         }
         // link the fan of new faces around the eye
         for (i, &(a, b, _)) in horizon.iter().enumerate() {
-            let next = horizon.iter().position(|&(s, _, _)| s == b);
-            let prev = horizon.iter().position(|&(_, e, _)| e == a);
-            let (Some(next), Some(prev)) = (next, prev) else {
+            if start_stamp[b as usize] != iteration || end_stamp[a as usize] != iteration {
                 return Err(degenerate("numerically degenerate point set"));
-            };
-            faces[first_new + i].nb[1] = first_new + next;
-            faces[first_new + i].nb[2] = first_new + prev;
-        }
-        for p in orphans {
-            if p == eye {
-                continue;
             }
-            let pt = &points[p];
-            if let Some(f) = faces[first_new..].iter_mut().find(|f| f.distance(pt) > eps) {
-                f.outside.push(p);
+            let f = new_faces[i] as usize;
+            fs.faces[f].nb[1] = new_faces[starts_at[b as usize] as usize];
+            fs.faces[f].nb[2] = new_faces[ends_at[a as usize] as usize];
+        }
+        // the conflict points of the visible faces, in order, go to the first
+        // new face they are outside of (or are inside the hull)
+        for &vf in &visible {
+            let mut p = fs.faces[vf as usize].head;
+            while p != NONE {
+                let following = fs.next[p as usize];
+                if p != eye {
+                    let pt = &points[p as usize];
+                    for &f in &new_faces {
+                        let d = fs.planes[f as usize].distance(pt);
+                        if d > eps {
+                            fs.assign(f, p, d);
+                            break;
+                        }
+                    }
+                }
+                p = following;
             }
         }
-        pending.extend((first_new..faces.len()).filter(|&i| !faces[i].outside.is_empty()));
+        fs.free.extend_from_slice(&visible);
+        for &f in &new_faces {
+            let face = &fs.faces[f as usize];
+            if face.head != NONE {
+                pending.push((f, face.generation));
+            }
+        }
     }
-    Ok(faces.into_iter().filter(|f| f.alive).map(|f| f.v).collect())
+    Ok(fs
+        .faces
+        .iter()
+        .filter(|f| f.alive)
+        .map(|f| f.v.map(|i| i as usize))
+        .collect())
 }
 
 #[cfg(test)]
