@@ -32,8 +32,18 @@ fn main() -> Result<(), packer_quadtree::Error> {
     let t = std::time::Instant::now();
     let p = pack(&domain, &Grading::pinto_table_3_4(), &params, &mut rng)?;
     let dt = t.elapsed().as_secs_f64();
+    // FNV-1a over the bit patterns of every centre and radius (as the
+    // golden test): equal digests mean bit-identical packings.
+    let mut digest = 0xcbf2_9ce4_8422_2325_u64;
+    for d in &p.disks {
+        for v in [d.center.x, d.center.y, d.radius] {
+            for b in v.to_bits().to_le_bytes() {
+                digest = (digest ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+    }
     println!(
-        "{w} x {h}: {} disks, porosity {:.4}, {dt:.3} s, {} front visits",
+        "{w} x {h}: {} disks, porosity {:.4}, {dt:.3} s, {} front visits, digest {digest:#018x}",
         p.disks.len(),
         porosity(&domain, &p.disks)?,
         p.stats.front_visits

@@ -22,6 +22,10 @@ pub trait SpatialIndex {
     /// closed box `[min, max]` (every point inside is reported; the caller
     /// filters by exact distance).
     fn query(&self, min: Point2<f64>, max: Point2<f64>, out: &mut Vec<u32>);
+    /// Calls `visit` with the id of a superset of the points inside the
+    /// closed box `[min, max]`, in the order [`SpatialIndex::query`] reports
+    /// them (the packer's allocation-free query path).
+    fn for_each_in(&self, min: Point2<f64>, max: Point2<f64>, visit: impl FnMut(u32));
     /// Heap memory held by the index, in bytes.
     fn heap_bytes(&self) -> usize;
 }
@@ -86,14 +90,19 @@ impl SpatialIndex for CellGrid {
 
     #[inline]
     fn query(&self, min: Point2<f64>, max: Point2<f64>, out: &mut Vec<u32>) {
+        self.for_each_in(min, max, |id| out.push(id));
+    }
+
+    #[inline]
+    fn for_each_in(&self, min: Point2<f64>, max: Point2<f64>, mut visit: impl FnMut(u32)) {
         let (x0, y0) = self.cell_of(min.x, min.y);
         let (x1, y1) = self.cell_of(max.x, max.y);
         for iy in y0..=y1 {
             let row = iy * self.nx;
-            for ix in x0..=x1 {
-                let mut id = self.head[row + ix];
+            for &head in &self.head[row + x0..=row + x1] {
+                let mut id = head;
                 while id != NIL {
-                    out.push(id);
+                    visit(id);
                     id = self.next[id as usize];
                 }
             }
@@ -139,7 +148,7 @@ impl MxQuadtree {
         ny: u32,
         lo: (u32, u32),
         hi: (u32, u32),
-        out: &mut Vec<u32>,
+        visit: &mut impl FnMut(u32),
     ) {
         // Node covers [nx, nx + size) × [ny, ny + size) in unit cells.
         let size = 1u32 << (self.depth - level);
@@ -150,7 +159,7 @@ impl MxQuadtree {
         if level == self.depth {
             let mut id = n[0];
             while id != NIL {
-                out.push(id);
+                visit(id);
                 id = self.next[id as usize];
             }
             return;
@@ -166,7 +175,7 @@ impl MxQuadtree {
                     ny + (q >> 1) * half,
                     lo,
                     hi,
-                    out,
+                    visit,
                 );
             }
         }
@@ -217,9 +226,13 @@ impl SpatialIndex for MxQuadtree {
     }
 
     fn query(&self, min: Point2<f64>, max: Point2<f64>, out: &mut Vec<u32>) {
+        self.for_each_in(min, max, |id| out.push(id));
+    }
+
+    fn for_each_in(&self, min: Point2<f64>, max: Point2<f64>, mut visit: impl FnMut(u32)) {
         let lo = self.coords(min.x, min.y);
         let hi = self.coords(max.x, max.y);
-        self.query_node(0, 0, 0, 0, lo, hi, out);
+        self.query_node(0, 0, 0, 0, lo, hi, &mut visit);
     }
 
     fn heap_bytes(&self) -> usize {
