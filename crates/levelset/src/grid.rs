@@ -276,8 +276,10 @@ impl Grid {
     }
 
     /// Trilinear value at any point. Outside the grid box the value at the nearest box
-    /// point plus the distance to the box is returned (continuous, never smaller than the
-    /// true distance for a grain inside the box). A non-finite point gives NaN.
+    /// point plus the distance to the box is returned (continuous, and for a grain inside
+    /// the box positive; never smaller than the true distance when the grid holds a distance
+    /// up to its boundary, which the band star build does not: its exterior beyond the band
+    /// is a lower bound). A non-finite point gives NaN.
     pub fn value(&self, p: &Point3<f64>) -> f64 {
         let lo = self.spec.origin;
         let hi = self.spec.max_corner();

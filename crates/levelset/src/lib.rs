@@ -7,7 +7,8 @@
 //!   [`Grid::closest_point`], [`Grid::surface_nodes`].
 //! * Construction: analytic [`Shape`]s ([`Sphere`], [`Ellipsoid`], [`Cuboid`], [`Cylinder`])
 //!   via [`Grid::from_shape`]; [`Superellipsoid`] and any star-shaped radius function via
-//!   [`Grid::from_star`] (cube-map direction table + fast sweeping, [`StarParams`]);
+//!   [`Grid::from_star`] (cube-map direction table, narrow-band second-order distances and a
+//!   closest-point interior, or the seed's full fast sweeping: [`StarParams`], [`Redistance`]);
 //!   closed triangle meshes via [`Grid::from_mesh`] ([`MeshDistance`]: BVH + pseudonormals);
 //!   voxel images via [`Grid::from_voxels`] (exact EDT) and [`Grid::from_grayscale`];
 //!   [`Grid::reinitialise`] (fast sweeping).
@@ -84,4 +85,4 @@ pub use grid::{Grid, GridSpec};
 pub use mesh::{MeshDistance, TriMesh};
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
-pub use star::{DirectionTable, StarBuild, StarParams};
+pub use star::{BAND_CELLS, DirectionTable, Redistance, StarBuild, StarParams};

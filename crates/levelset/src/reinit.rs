@@ -125,6 +125,29 @@ pub(crate) fn redistance(spec: &GridSpec, values: &mut [f64], upper_bound: bool)
     if !any_interface {
         return Err(Error::NoSurface);
     }
+    sweep(spec.dims, h, &mut u, &fixed);
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let g = i + nx * (j + ny * k);
+                let p = (i + 1) + sy * (j + 1) + sz * (k + 1);
+                let d = u[p];
+                values[g] = if values[g] < 0.0 { -d } else { d };
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The 2³ fast sweeps on a padded array: `u` and `fixed` hold `(nx+2)·(ny+2)·(nz+2)`
+/// entries (x fastest), node `(i, j, k)` of the grid at padded index
+/// `(i+1) + (nx+2)·((j+1) + (ny+2)·(k+1))`; the padding must be `+∞` and fixed. Unsigned
+/// distances: fixed nodes are the sources, every other node ends with the minimum of its
+/// start value and the Godunov solution from its neighbours.
+pub(crate) fn sweep(dims: [usize; 3], h: f64, u: &mut [f64], fixed: &[bool]) {
+    let [nx, ny, nz] = dims;
+    let (px, py) = (nx + 2, ny + 2);
+    let (sy, sz) = (px, px * py);
     let h2 = h * h;
     for sweep in 0..8 {
         let (fx, fy, fz) = (sweep & 1 == 0, sweep & 2 == 0, sweep & 4 == 0);
@@ -176,17 +199,6 @@ pub(crate) fn redistance(spec: &GridSpec, values: &mut [f64], upper_bound: bool)
             }
         }
     }
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                let g = i + nx * (j + ny * k);
-                let p = (i + 1) + sy * (j + 1) + sz * (k + 1);
-                let d = u[p];
-                values[g] = if values[g] < 0.0 { -d } else { d };
-            }
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -1,7 +1,8 @@
 //! Acceptance oracles of issue 3 that cross modules (mesh path, gradient norm, builds).
 
 use levelset::{
-    Body, Cylinder, Grid, GridSpec, MeshDistance, Sphere, StarParams, Superellipsoid, contact,
+    Body, Cylinder, Grid, GridSpec, MeshDistance, Redistance, Sphere, StarParams, Superellipsoid,
+    contact,
 };
 use nalgebra::{Isometry3, Point3, Vector3};
 
@@ -27,10 +28,24 @@ fn sphere_gradient_norm_is_one_in_the_band() {
         &StarParams::default(),
     )
     .expect("star");
-    // Not the acceptance grid: the star build is redistanced by first-order fast sweeping,
-    // whose error shows in |∇φ| away from the fixed interface nodes (measured 0.037).
+    // The default (band) star build meets the acceptance bound too (measured 0.0004: the
+    // second-order band estimate is exact for a sphere about the centre).
     let e = gradient_norm_error(&star);
-    assert!(e < 0.05, "star-built sphere: {e}");
+    assert!(e < 0.02, "star-built sphere: {e}");
+    // The seed method (first-order fast sweeping over the whole grid) errs in |∇φ| away from
+    // the fixed interface nodes (measured 0.037).
+    let (full, _) = Grid::from_star(
+        *g.spec(),
+        &Point3::origin(),
+        |_| 1.0,
+        &StarParams {
+            redistance: Redistance::FullSweep,
+            ..StarParams::default()
+        },
+    )
+    .expect("star");
+    let e = gradient_norm_error(&full);
+    assert!(e < 0.05, "star-built sphere, full sweep: {e}");
 }
 
 #[test]
