@@ -25,7 +25,9 @@
 //! * [`measure()`]: the per-grain descriptors of a `levelset::Grid` (only
 //!   those asked for are computed), [`measure_star`] for any star-shaped
 //!   radius function (e.g. a spherical-harmonic model), [`measure_table`] for
-//!   a population; [`principal_frame`] (deterministic axis signs) and
+//!   a population, [`measure_with_frame`] for the descriptors and the
+//!   principal frame from one pass; [`principal_frame`] (deterministic axis
+//!   signs) and
 //!   [`radial_profile`] on a [`SphericalMesh`]; [`convex_hull_volume`]
 //!   (Quickhull) for the convexity. Definitions and the roundness corner rule
 //!   are in the [`mod@measure`] module docs.
@@ -109,7 +111,7 @@ pub use histogram::{BinAxis, Histogram1d, Histogram2d};
 pub use hull::{convex_hull, convex_hull_volume};
 pub use measure::{
     CornerAveraging, MeasureParams, PrincipalFrame, max_principal_curvature, measure, measure_star,
-    measure_table, principal_frame, radial_profile,
+    measure_table, measure_with_frame, principal_frame, radial_profile,
 };
 pub use pdf::{Bandwidth, BicubicPdf, GaussianKde2d, TabulatedPdf2d};
 pub use radial::{

@@ -100,8 +100,13 @@ impl PrincipalFrame {
 /// [`Error::LevelSet`] if the grid holds no closed surface.
 pub fn principal_frame(grid: &Grid) -> Result<PrincipalFrame> {
     let mp = grid.mass_properties().map_err(ls_err)?;
+    Ok(frame_from(grid, &mp, &mp.principal()))
+}
+
+/// [`principal_frame`] from already integrated mass properties and their
+/// principal decomposition.
+fn frame_from(grid: &Grid, mp: &MassProperties, principal: &levelset::Principal) -> PrincipalFrame {
     // levelset's decomposition: moments ascending, axes as matching columns
-    let principal = mp.principal();
     let moments = principal.moments;
     let mut e: Vec<Vector3<f64>> = (0..3)
         .map(|a| principal.axes.column(a).into_owned())
@@ -133,13 +138,13 @@ pub fn principal_frame(grid: &Grid) -> Result<PrincipalFrame> {
         }
     }
     e[2] = e[0].cross(&e[1]);
-    Ok(PrincipalFrame {
+    PrincipalFrame {
         centroid: c,
         axes: Matrix3::from_columns(&[e[0], e[1], e[2]]),
         moments,
         volume: mp.volume,
         area: mp.area,
-    })
+    }
 }
 
 /// Parameters of [`measure`].
@@ -475,8 +480,43 @@ impl Needs {
 /// inside, or the surface touching the grid border is closed by the grid
 /// box), [`Error::InvalidParameter`] for invalid params or a degenerate grain.
 pub fn measure(grid: &Grid, wanted: &[Descriptor], params: &MeasureParams) -> Result<Vec<f64>> {
+    Ok(measure_impl(grid, wanted, params, false)?.0)
+}
+
+/// [`measure`] and the grain's [`PrincipalFrame`] (as [`principal_frame`]
+/// gives it, for [`radial_profile`]) from one integration pass: cheaper than
+/// calling both. When `wanted` needs the marching-cubes surface the frame's
+/// volume, area, centroid and moments are integrated over that surface, so
+/// they can differ from [`principal_frame`]'s in the last bits. Costs
+/// [`measure`]'s plus one pass over the grid nodes for the axis signs
+/// (≈ 0.1 ms at 45³).
+///
+/// # Errors
+/// As [`measure`].
+pub fn measure_with_frame(
+    grid: &Grid,
+    wanted: &[Descriptor],
+    params: &MeasureParams,
+) -> Result<(Vec<f64>, PrincipalFrame)> {
+    let (values, frame) = measure_impl(grid, wanted, params, true)?;
+    let Some(frame) = frame else {
+        unreachable_state()?
+    };
+    Ok((values, frame))
+}
+
+fn measure_impl(
+    grid: &Grid,
+    wanted: &[Descriptor],
+    params: &MeasureParams,
+    with_frame: bool,
+) -> Result<(Vec<f64>, Option<PrincipalFrame>)> {
     params.validate()?;
-    let needs = Needs::of(wanted);
+    let mut needs = Needs::of(wanted);
+    if with_frame {
+        needs.volume = true;
+        needs.principal = true;
+    }
     if grid.values().iter().all(|v| *v < 0.0) {
         return Err(Error::LevelSet {
             message: "every node is inside: the grain does not fit in its grid".into(),
@@ -573,14 +613,18 @@ pub fn measure(grid: &Grid, wanted: &[Descriptor], params: &MeasureParams) -> Re
         }
         out.push(v);
     }
-    Ok(out)
+    let frame = match (&mp, &principal) {
+        (Some(m), Some(p)) if with_frame => Some(frame_from(grid, m, p)),
+        _ => None,
+    };
+    Ok((out, frame))
 }
 
 fn unreachable_state<T>() -> Result<T> {
     Err(Error::InvalidParameter {
         name: "internal state",
         value: f64::NAN,
-        reason: "surface mesh computed whenever a descriptor needs it",
+        reason: "intermediate results computed whenever a descriptor needs them",
     })
 }
 

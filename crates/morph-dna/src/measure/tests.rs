@@ -327,3 +327,36 @@ fn batched_curvature_is_pointwise_curvature() {
         }
     }
 }
+
+/// `measure_with_frame` gives `measure`'s values and `principal_frame`'s
+/// frame (bit for bit without the surface, to the last bits with it).
+#[test]
+fn measure_with_frame_matches_measure_and_principal_frame() {
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.1, -0.05, 0.02),
+        UnitQuaternion::from_euler_angles(0.3, -0.7, 1.1),
+    );
+    let g = ellipsoid_grid(&pose);
+    let p = MeasureParams::default();
+    let reference = principal_frame(&g).expect("frame");
+    let cheap = [Descriptor::AspectRatio, Descriptor::EquivalentDiameter];
+    let (v, f) = measure_with_frame(&g, &cheap, &p).expect("measure");
+    assert_eq!(v, measure(&g, &cheap, &p).expect("measure"));
+    assert_eq!(f, reference);
+    let (v, f) = measure_with_frame(&g, &ALL, &p).expect("measure");
+    assert_eq!(v, measure(&g, &ALL, &p).expect("measure"));
+    assert!((f.volume / reference.volume - 1.0).abs() < 1e-12);
+    assert!((f.axes - reference.axes).abs().max() < 1e-9);
+    assert!((f.centroid - reference.centroid).norm() < 1e-12);
+    assert!(
+        measure_with_frame(
+            &g,
+            &ALL,
+            &MeasureParams {
+                corner_margin: -1.0,
+                ..p
+            }
+        )
+        .is_err()
+    );
+}
