@@ -1,9 +1,10 @@
 //! Criterion bench: every descriptor of one grain on a 45³ level set
-//! (issue 5 target ≤ 2 ms), and the cheap volume-type subset.
+//! (issue 5 target ≤ 2 ms), the cheap volume-type subset, the cloner's
+//! subset, and roundness and convexity alone.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use levelset::{Ellipsoid, Grid, GridSpec};
-use morph_dna::{Descriptor, MeasureParams, measure};
+use morph_dna::{Descriptor, MeasureParams, measure, measure_with_frame};
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 use std::hint::black_box;
 
@@ -33,6 +34,22 @@ fn bench(c: &mut Criterion) {
     ];
     c.bench_function("volume-type descriptors, 45^3 ellipsoid", |b| {
         b.iter(|| measure(black_box(&g), &cheap, &params).expect("measure"));
+    });
+    // what the cloner asks of every clone (crates/cloner, surface DNA)
+    let cloner = [
+        Descriptor::AspectRatio,
+        Descriptor::EquivalentDiameter,
+        Descriptor::Roundness,
+        Descriptor::VolumeSurfaceRatio,
+        Descriptor::MajorPrincipalDimension,
+        Descriptor::IntermediatePrincipalDimension,
+        Descriptor::MinPrincipalDimension,
+    ];
+    c.bench_function("cloner subset, 45^3 ellipsoid", |b| {
+        b.iter(|| measure(black_box(&g), &cloner, &params).expect("measure"));
+    });
+    c.bench_function("cloner subset with frame, 45^3 ellipsoid", |b| {
+        b.iter(|| measure_with_frame(black_box(&g), &cloner, &params).expect("measure"));
     });
     c.bench_function("roundness only, 45^3 ellipsoid", |b| {
         b.iter(|| measure(black_box(&g), &[Descriptor::Roundness], &params).expect("measure"));

@@ -2,11 +2,14 @@
 //! a grain and its radial profile on the spherical mesh (Medina 2018,
 //! §2.1–2.3; definitions in [`Descriptor`]).
 //!
-//! Only what is asked for is computed: volume-type descriptors need one pass
-//! of exact piecewise-linear integration over the zero level set
+//! Only what is asked for is computed ([`measure`] lists the costs):
+//! volume-type descriptors and the principal dimensions need one pass of
+//! exact piecewise-linear integration over the zero level set
 //! (`levelset::Grid::mass_properties`); extents, convexity and roundness
-//! additionally need the marching-cubes surface; roundness needs curvatures
-//! and the inscribed sphere.
+//! need the marching-cubes surface, and when it is built the integrals are
+//! taken over its triangles instead (the same triangles); roundness needs
+//! curvatures (nodal Hessians computed once per node) and the inscribed
+//! sphere; convexity the exact convex hull of the surface vertices.
 //!
 //! # Design choices the seed leaves open
 //!
