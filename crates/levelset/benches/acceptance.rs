@@ -1,8 +1,9 @@
-//! Acceptance benchmarks of issue 3 on 45³ grids: star build (incl. reinitialisation),
+//! Acceptance benchmarks of issue 3 on 45³ grids: star build (incl. redistancing; default
+//! band build and the seed's full sweep),
 //! marching cubes, volume + area + inertia, contact of 1,000 nodes.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use levelset::{Body, Grid, GridSpec, Sphere, StarParams, contact_into};
+use levelset::{Body, Grid, GridSpec, Redistance, Sphere, StarParams, contact_into};
 use nalgebra::{Isometry3, Point3, Unit, Vector3};
 use std::hint::black_box;
 
@@ -23,6 +24,14 @@ fn benches(c: &mut Criterion) {
         b.iter(|| {
             Grid::from_star(spec, &Point3::origin(), lumpy, &StarParams::default()).expect("build")
         })
+    });
+    // The seed method, for comparison.
+    let full = StarParams {
+        redistance: Redistance::FullSweep,
+        ..StarParams::default()
+    };
+    c.bench_function("star_build_45_full_sweep", |b| {
+        b.iter(|| Grid::from_star(spec, &Point3::origin(), lumpy, &full).expect("build"))
     });
     let (star, _) =
         Grid::from_star(spec, &Point3::origin(), lumpy, &StarParams::default()).expect("build");

@@ -164,7 +164,7 @@ impl CubeMap {
     }
 
     /// Interpolated radius for a non-zero (not necessarily unit) direction.
-    #[inline]
+    #[inline(always)]
     fn radius(&self, d: &Vector3<f64>) -> f64 {
         let (ax, ay, az) = (d.x.abs(), d.y.abs(), d.z.abs());
         // Major axis `a` and the face coordinates (u, v) along OTHER[axis].
@@ -249,17 +249,26 @@ impl Grid {
                 let inner = (rmin - w).max(0.0);
                 let inner2 = inner * inner;
                 let outer2 = (rmax + w) * (rmax + w);
+                let o = spec.origin - centre;
                 for k in 0..nz {
+                    let z = o.z + h * k as f64;
                     for j in 0..ny {
+                        let y = o.y + h * j as f64;
+                        let yz2 = y * y + z * z;
+                        if yz2 > outer2 {
+                            // The whole row is outside the shell.
+                            values.extend(std::iter::repeat_n(FAR, nx));
+                            continue;
+                        }
                         for i in 0..nx {
-                            let d = spec.node(i, j, k) - centre;
-                            let rho2 = d.norm_squared();
+                            let x = o.x + h * i as f64;
+                            let rho2 = x * x + yz2;
                             values.push(if rho2 < inner2 {
                                 -FAR
                             } else if rho2 > outer2 {
                                 FAR
                             } else if rho2 > 1e-24 * h * h {
-                                rho2.sqrt() - map.radius(&d)
+                                rho2.sqrt() - map.radius(&Vector3::new(x, y, z))
                             } else {
                                 -map.radius(&Vector3::z())
                             });
@@ -400,14 +409,16 @@ fn crosses(spec: &GridSpec, g: &[f64]) -> bool {
 
 /// Second-order distances of the band nodes (NaN elsewhere).
 #[inline(never)]
-fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f64> {
+fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f32> {
     let [nx, ny, nz] = spec.dims;
     let h = spec.spacing;
     let (sy, sz) = (nx, nx * ny);
     let band_w = BAND_CELLS * h;
     let o = spec.origin.coords - centre.coords;
     let cut2 = (1.3 * band_w).powi(2);
-    let mut band = vec![f64::NAN; g.len()];
+    // f32 storage halves the memory traffic; its rounding (≈ 1e-8·h) is far below the
+    // estimate's error.
+    let mut band = vec![f32::NAN; g.len()];
     for k in 1..nz - 1 {
         for j in 1..ny - 1 {
             let row = sy * j + sz * k;
@@ -432,7 +443,7 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f64> {
                 }
                 let d = second_order_distance(g, c, sy, sz, h, cut2);
                 if d.abs() < band_w {
-                    band[c] = d;
+                    band[c] = d as f32;
                 }
             }
         }
@@ -456,9 +467,9 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f64> {
                 if band[c].is_nan() || band[c] >= 0.0 {
                     continue;
                 }
-                let gx = band[c + 1] - band[c - 1];
-                let gy = band[c + sy] - band[c - sy];
-                let gz = band[c + sz] - band[c - sz];
+                let gx = f64::from(band[c + 1]) - f64::from(band[c - 1]);
+                let gy = f64::from(band[c + sy]) - f64::from(band[c - sy]);
+                let gz = f64::from(band[c + sz]) - f64::from(band[c - sz]);
                 let n2 = gx * gx + gy * gy + gz * gz;
                 // NaN (a neighbour outside the band) fails both comparisons: kept.
                 if n2 > hi2 || n2 < lo2 {
@@ -468,7 +479,7 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f64> {
         }
     }
     for c in demote {
-        band[c] = f64::NAN;
+        band[c] = f32::NAN;
     }
     band
 }
@@ -500,7 +511,7 @@ impl Coarse {
         spec: &GridSpec,
         centre: &Point3<f64>,
         g: &[f64],
-        band: &[f64],
+        band: &[f32],
         rmax: f64,
     ) -> Result<Self> {
         let [nx, ny, nz] = spec.dims;
@@ -532,7 +543,7 @@ impl Coarse {
                     // Nodes beyond the grid take the sign of the last grid node.
                     let (i, j, k) = (2 * ic, 2 * jc, 2 * kc);
                     let c = i.min(nx - 1) + sy * j.min(ny - 1) + sz * k.min(nz - 1);
-                    let d = band[c];
+                    let d = f64::from(band[c]);
                     let inside = g[c] < 0.0;
                     if i < nx && j < ny && k < nz && d.abs() <= SOURCE_CELLS * h {
                         // Band nodes are interior nodes, so the stencil exists.
@@ -622,7 +633,7 @@ impl Coarse {
         spec: &GridSpec,
         centre: &Point3<f64>,
         g: &mut [f64],
-        band: &[f64],
+        band: &[f32],
         rmax: f64,
     ) {
         let [nx, ny, nz] = spec.dims;
@@ -647,20 +658,6 @@ impl Coarse {
                 }
             }
         }
-        let mut ay = vec![0.0; nx * ny * m[2]];
-        for kc in 0..m[2] {
-            for j in 0..ny {
-                let dst = nx * (j + ny * kc);
-                let s0 = nx * (j / 2 + m[1] * kc);
-                if j % 2 == 0 {
-                    ay[dst..dst + nx].copy_from_slice(&ax[s0..s0 + nx]);
-                } else {
-                    for i in 0..nx {
-                        ay[dst + i] = 0.5 * (ax[s0 + i] + ax[s0 + nx + i]);
-                    }
-                }
-            }
-        }
         let band_w = BAND_CELLS * h;
         let reach2 = (rmax + band_w) * (rmax + band_w);
         let o = spec.origin.coords - centre.coords;
@@ -670,34 +667,42 @@ impl Coarse {
                 let y = o.y + h * j as f64;
                 let yz2 = y * y + z * z;
                 let dst = sy * j + sz * k;
-                let s0 = nx * (j + ny * (k / 2));
-                let s1 = s0 + nx * ny;
+                // The (up to four) coarse rows around the fine row and their weights.
+                let (j0, j1) = (j / 2, j.div_ceil(2));
+                let (k0, k1) = (k / 2, k.div_ceil(2));
+                let r = [
+                    nx * (j0 + m[1] * k0),
+                    nx * (j1 + m[1] * k0),
+                    nx * (j0 + m[1] * k1),
+                    nx * (j1 + m[1] * k1),
+                ];
                 for i in 0..nx {
                     let c = dst + i;
-                    let b = band[c];
-                    let interp = if k % 2 == 0 {
-                        ay[s0 + i]
-                    } else {
-                        0.5 * (ay[s0 + i] + ay[s1 + i])
-                    };
-                    // Beyond the sources a band value must agree with the far field (robust
-                    // near ridges, where an expansion can underestimate); outside, the far
-                    // field is only a bound, so band values are kept.
+                    let b = f64::from(band[c]);
                     let inside = g[c] < 0.0;
-                    let trusted = b.abs() <= SOURCE_CELLS * h
-                        || (b.is_finite() && (!inside || (b - interp).abs() <= AGREEMENT * h));
-                    g[c] = if trusted {
-                        b
-                    } else if inside {
-                        // An interpolated value of the other sign (next to the surface) is
-                        // small; only its magnitude is kept.
-                        -interp.abs()
-                    } else {
+                    // Band values within the sources, and outside (where the far field is
+                    // only a bound), are kept.
+                    if b.abs() <= SOURCE_CELLS * h || (b.is_finite() && !inside) {
+                        g[c] = b;
+                        continue;
+                    }
+                    if !inside {
                         let x = o.x + h * i as f64;
                         let rho2 = x * x + yz2;
                         // ρ − r_max only matters beyond r_max + band width (no root before).
                         let rho = if rho2 > reach2 { rho2.sqrt() } else { 0.0 };
-                        exterior_value(rho, g[c], rmax, band_w)
+                        g[c] = exterior_value(rho, g[c], rmax, band_w);
+                        continue;
+                    }
+                    let interp = 0.25 * (ax[r[0] + i] + ax[r[1] + i] + ax[r[2] + i] + ax[r[3] + i]);
+                    // Inside beyond the sources a band value must agree with the far field
+                    // (robust near ridges, where an expansion can underestimate); an
+                    // interpolated value of the other sign (next to the surface) is small, and
+                    // only its magnitude is kept.
+                    g[c] = if (b - interp).abs() <= AGREEMENT * h {
+                        b
+                    } else {
+                        -interp.abs()
                     };
                 }
             }
