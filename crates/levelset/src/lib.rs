@@ -12,7 +12,8 @@
 //!   closed triangle meshes via [`Grid::from_mesh`] ([`MeshDistance`]: BVH + pseudonormals);
 //!   voxel images via [`Grid::from_voxels`] (exact EDT) and [`Grid::from_grayscale`];
 //!   [`Grid::reinitialise`] (fast sweeping).
-//! * Properties on request: [`Grid::volume`], [`Grid::area`], [`Grid::mass_properties`]
+//! * Properties on request: [`Grid::volume`] (sharp-feature corrected; [`Grid::volume_linear`]
+//!   without), [`Grid::area`], [`Grid::mass_properties`]
 //!   ([`MassProperties::principal`]), [`Grid::bounding_box`], [`Grid::inscribed_sphere`],
 //!   [`Grid::equivalent_diameter`].
 //! * [`Grid::marching_cubes`] → [`TriMesh`] (closed, oriented, shared vertices).
@@ -72,6 +73,7 @@ pub mod mesh;
 pub mod properties;
 pub mod reinit;
 pub mod shapes;
+mod sharp;
 pub mod star;
 pub mod surface;
 pub mod voxel;
