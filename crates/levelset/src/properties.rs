@@ -7,7 +7,7 @@
 //! (sphere R = 1 on 45³ over [−1.2, 1.2]³: see the tests for the measured errors), unlike a
 //! smoothed Heaviside whose error is O(h) in the band width. Where the linear reconstruction
 //! is not trusted (cells with a corner whose gradient is not a unit vector: sharp edges and
-//! kinks), [`crate::sharp`] replaces the cell's volume by the exact volume under the corner
+//! kinks), the `sharp` module replaces the cell's volume by the exact volume under the corner
 //! tangent planes (box 2 × 1 × 0.5 on 45³: −0.70 % → −0.04 %); [`Grid::volume_linear`]
 //! keeps the uncorrected volume. Tetrahedron moments:
 //! `∫ x xᵀ dV = V/20 · (Σ vᵢvᵢᵀ + s sᵀ)`, `s = Σ vᵢ` (Tonon 2004, J. Math. Stat. 1, Eq. 9–15).
@@ -135,7 +135,7 @@ impl Grid {
     }
 
     /// Volume enclosed by the zero level set (0 if no node is inside): the piecewise-linear
-    /// volume with the sharp-feature correction of [`crate::sharp`] (no change for surfaces
+    /// volume with the sharp-feature correction of the `sharp` module (no change for surfaces
     /// the grid resolves; the convex edges of a box are no longer cut).
     pub fn volume(&self) -> f64 {
         let (s, corrections) = self.integrate::<false, false, true>();

@@ -160,7 +160,7 @@ impl Clipper {
             self.keyed.clear();
             for p in &self.cut {
                 let d = p.coords - c;
-                self.keyed.push((d.dot(&e2).atan2(d.dot(&e1)), *p));
+                self.keyed.push((pseudo_angle(d.dot(&e1), d.dot(&e2)), *p));
             }
             self.keyed.sort_by(|x, y| x.0.total_cmp(&y.0));
             let first = self.next.pts.len();
@@ -175,6 +175,21 @@ impl Clipper {
             self.next.close_face(first);
         }
         std::mem::swap(&mut self.poly, &mut self.next);
+    }
+}
+
+/// A monotone function of the angle of `(x, y)` in [0, 4) (no trigonometry).
+#[inline]
+fn pseudo_angle(x: f64, y: f64) -> f64 {
+    let s = x.abs() + y.abs();
+    if s == 0.0 {
+        return 0.0;
+    }
+    let t = y / s;
+    if x >= 0.0 {
+        if y >= 0.0 { t } else { 4.0 + t }
+    } else {
+        2.0 - t
     }
 }
 
@@ -394,6 +409,27 @@ fn cell_correction(
         }
         if inside == 4 {
             linear += h * h * h / 6.0;
+            continue;
+        }
+        let tet_v = h * h * h / 6.0;
+        if inside == 1 || inside == 3 {
+            // A lone vertex: the corner tetrahedron it cuts off is the product of the
+            // crossing parameters along its three edges.
+            let lone_inside = inside == 1;
+            let Some(&l) = t.iter().find(|&&c| (phi[c as usize] < 0.0) == lone_inside) else {
+                continue;
+            };
+            let fl = phi[l as usize];
+            let cut: f64 = t
+                .iter()
+                .filter(|&&c| c != l)
+                .map(|&c| fl / (fl - phi[c as usize]))
+                .product();
+            linear += if lone_inside {
+                tet_v * cut
+            } else {
+                tet_v * (1.0 - cut)
+            };
             continue;
         }
         let pts = t.map(|c| corner(c as usize));

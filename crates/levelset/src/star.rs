@@ -415,7 +415,7 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f32> {
     let (sy, sz) = (nx, nx * ny);
     let band_w = BAND_CELLS * h;
     let o = spec.origin.coords - centre.coords;
-    let cut2 = (1.3 * band_w).powi(2);
+    let cut2 = (1.15 * band_w).powi(2);
     // f32 storage halves the memory traffic; its rounding (≈ 1e-8·h) is far below the
     // estimate's error.
     let mut band = vec![f32::NAN; g.len()];
@@ -433,7 +433,8 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f32> {
                 // than 2·BAND_CELLS cells, which then take far-field values). Far markers
                 // (±∞) fail the test too.
                 // Cheap screen first: the first-order estimate |g|/|∇g| with |∇g| ≤ 2 must be
-                // below `cut` (the guards below allow a 30 % correction).
+                // below 1.15 band widths (a node needing a larger second-order correction
+                // takes the far field).
                 if v * v >= 4.0 * cut2 {
                     continue;
                 }
@@ -525,10 +526,12 @@ impl Coarse {
         let (px, py) = (m[0] + 2, m[1] + 2);
         let pz = px * py;
         let plen = pz * (m[2] + 2);
-        let nan = f64::NAN;
+        let nan = f32::NAN;
+        // Closest points (f32: ≈ 1e-7 relative, far below the method's error) and one value
+        // per node: the squared distance of the closest point while an active node is
+        // propagated, the final signed value for every other node.
         let (mut cx, mut cy, mut cz) = (vec![nan; plen], vec![nan; plen], vec![nan; plen]);
-        let mut d2 = vec![f64::INFINITY; plen];
-        let mut dist = vec![0.0; plen];
+        let mut dist = vec![f64::INFINITY; plen];
         // Interior non-source nodes to update: per coarse row, the index range.
         let mut active = vec![false; plen];
         let mut ranges = vec![(usize::MAX, 0usize); m[1] * m[2]];
@@ -553,8 +556,7 @@ impl Coarse {
                             (g[c + sz] - g[c - sz]) * inv2h,
                         );
                         let x = spec.node(i, j, k).coords - grad * (d / grad.norm());
-                        (cx[p], cy[p], cz[p]) = (x.x, x.y, x.z);
-                        d2[p] = d * d;
+                        (cx[p], cy[p], cz[p]) = (x.x as f32, x.y as f32, x.z as f32);
                         dist[p] = d;
                         any_source = true;
                     } else if inside {
@@ -599,18 +601,22 @@ impl Coarse {
                             continue;
                         }
                         let x = o.x + hc * ic as f64;
-                        let mut best = d2[p];
+                        let mut best = dist[p];
                         let mut b = p;
                         for off in offs {
                             let q = p.wrapping_add_signed(off);
-                            let (ex, ey, ez) = (x - cx[q], y - cy[q], z - cz[q]);
+                            let (ex, ey, ez) = (
+                                x - f64::from(cx[q]),
+                                y - f64::from(cy[q]),
+                                z - f64::from(cz[q]),
+                            );
                             let e = ex * ex + ey * ey + ez * ez;
                             if e < best {
                                 best = e;
                                 b = q;
                             }
                         }
-                        d2[p] = best;
+                        dist[p] = best;
                         (cx[p], cy[p], cz[p]) = (cx[b], cy[b], cz[b]);
                     }
                 }
@@ -618,7 +624,7 @@ impl Coarse {
         }
         for p in 0..plen {
             if active[p] {
-                dist[p] = -d2[p].sqrt();
+                dist[p] = -dist[p].sqrt();
             }
         }
         Ok(Self { m, dist })
