@@ -14,8 +14,10 @@
 
 use clap::{Parser, Subcommand};
 
+mod calibrate;
 mod convergence;
 mod dna;
+mod svg;
 mod validate_cmd;
 
 #[cfg(test)]
@@ -31,6 +33,10 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// The main job: sweep the cloner over the seed's trial grid on the real
+    /// Ottawa-sand parents and write the calibration report
+    /// (`--check` re-scores the committed calibration).
+    Calibrate(calibrate::Calibrate),
     /// Run the reference validation cases and print the result table.
     Validate(validate_cmd::Validate),
     /// Measure the morphological DNA of every shipped real grain into
@@ -54,6 +60,7 @@ fn workspace_root() -> std::path::PathBuf {
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Calibrate(cmd) => cmd.run(&workspace_root()),
         Command::Validate(cmd) => cmd.run(),
         Command::Dna(cmd) => cmd.run(&workspace_root()),
         Command::Convergence(cmd) => cmd.run(&workspace_root()),

@@ -65,13 +65,20 @@ pub enum Error {
     },
     /// A clone index could not be accepted within the attempt limit.
     #[error(
-        "clone {index}: no candidate accepted in {attempts} attempts (quality control too strict for this population?)"
+        "clone {index}: no candidate accepted in {attempts} attempts (rejected: {} too round, {} roundness not reached, {} V/S quality control, {} degenerate, {} target unavailable)",
+        rejections.too_round,
+        rejections.roundness_unreached,
+        rejections.quality_control,
+        rejections.degenerate,
+        rejections.target_unavailable
     )]
     TooManyRejections {
         /// The clone index.
         index: u64,
         /// Attempts made.
         attempts: usize,
+        /// Why they were rejected.
+        rejections: crate::pipeline::Rejections,
     },
     /// An empty or reversed index range, or a shard that does not exist.
     #[error("invalid clone range {start}..{end}")]

@@ -19,15 +19,19 @@ use crate::surface::{MeshGeometry, SurfaceDna};
 
 /// The DNA measured on every parent and on every clone, in this order:
 /// aspect ratio, grain (equivalent) diameter, roundness, volume/surface
-/// ratio (Medina 2018, Tables 4–5), and the minimum principal dimension
-/// (Table 1).
-pub const DNA: [Descriptor; 5] = [
+/// ratio (Medina 2018, Tables 4–5), the minimum principal dimension
+/// (Table 1) and the flatness `S / I` (the embryo's intermediate axis).
+pub const DNA: [Descriptor; 6] = [
     Descriptor::AspectRatio,
     Descriptor::EquivalentDiameter,
     Descriptor::Roundness,
     Descriptor::VolumeSurfaceRatio,
     Descriptor::MinPrincipalDimension,
+    Descriptor::Flatness,
 ];
+
+/// Positions of [`TARGETS`] in [`DNA`].
+pub(crate) const TARGET_IN_DNA: [usize; 5] = [0, 4, 5, 2, 3];
 
 /// The four parameters of Medina 2018, Tables 4–5, in their order.
 pub const TABLES_4_5: [Descriptor; 4] = [
@@ -143,6 +147,28 @@ pub struct Targets {
 }
 
 impl Targets {
+    /// The targets as an array in [`TARGETS`] order.
+    pub fn to_array(&self) -> [f64; 5] {
+        [
+            self.aspect_ratio,
+            self.min_dimension,
+            self.flatness,
+            self.roundness,
+            self.volume_surface_ratio,
+        ]
+    }
+
+    /// Targets from an array in [`TARGETS`] order.
+    pub fn from_array(v: [f64; 5]) -> Self {
+        Self {
+            aspect_ratio: v[0],
+            min_dimension: v[1],
+            flatness: v[2],
+            roundness: v[3],
+            volume_surface_ratio: v[4],
+        }
+    }
+
     /// Full semi-axes `(L/2, I/2, S/2)` of the embryo ellipsoid (`I` clamped
     /// into `[S, L]`).
     pub fn semi_axes(&self) -> [f64; 3] {
@@ -153,6 +179,8 @@ impl Targets {
     }
 }
 
+// two per model, never in a collection: the size difference does not matter
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 enum TargetSampler {
     Seed {
@@ -184,6 +212,69 @@ enum RadiiSampler {
 /// Why a candidate draw failed inside the target sampler.
 pub(crate) struct TargetUnavailable;
 
+/// The target sampler of `model` on columns in [`TARGETS`] order.
+fn target_sampler(model: TargetModel, cols: &[Vec<f64>], bins: usize) -> Result<TargetSampler> {
+    Ok(match model {
+        TargetModel::Copula => TargetSampler::Copula(GaussianCopula::fit(
+            &DnaTable::from_columns(TARGETS.to_vec(), cols.to_vec())?,
+        )?),
+        TargetModel::Seed => {
+            let pdf = |x: &[f64], y: &[f64]| -> Result<AcceptanceRejection2d<BicubicPdf>> {
+                let h = Histogram2d::new(x, y, (bins, bins), None, None)?;
+                Ok(AcceptanceRejection2d::new(BicubicPdf::from_histogram(
+                    &h, 4,
+                )?)?)
+            };
+            let one = |x: &[f64]| -> Result<InverseCdfSampler1d> {
+                Ok(InverseCdfSampler1d::from_histogram(&Histogram1d::new(
+                    x, bins, None,
+                )?)?)
+            };
+            TargetSampler::Seed {
+                ar_s: pdf(&cols[0], &cols[1])?,
+                s_vs: pdf(&cols[1], &cols[4])?,
+                flatness: one(&cols[2])?,
+                roundness: one(&cols[3])?,
+            }
+        }
+    })
+}
+
+impl TargetSampler {
+    fn sample(&self, rng: &mut impl Rng) -> std::result::Result<Targets, TargetUnavailable> {
+        match self {
+            Self::Copula(c) => {
+                let v = c.sample(rng);
+                Ok(Targets {
+                    aspect_ratio: v[0],
+                    min_dimension: v[1],
+                    flatness: v[2].max(v[0]),
+                    roundness: v[3],
+                    volume_surface_ratio: v[4],
+                })
+            }
+            Self::Seed {
+                ar_s,
+                s_vs,
+                flatness,
+                roundness,
+            } => {
+                let (ar, s) = ar_s.sample(rng);
+                let vs = s_vs
+                    .sample_y_given_x(s, 100_000, rng)
+                    .map_err(|_| TargetUnavailable)?;
+                Ok(Targets {
+                    aspect_ratio: ar,
+                    min_dimension: s,
+                    flatness: flatness.sample(rng).max(ar),
+                    roundness: roundness.sample(rng),
+                    volume_surface_ratio: vs,
+                })
+            }
+        }
+    }
+}
+
 /// The population model: everything a clone is sampled from.
 #[derive(Debug, Clone)]
 pub struct CloneModel {
@@ -191,8 +282,72 @@ pub struct CloneModel {
     pub(crate) geom: MeshGeometry,
     surface: Vec<SurfaceDna>,
     profiles: Vec<Vec<f64>>,
-    targets: TargetSampler,
+    /// Targets in surface-DNA measure (the pilot's).
+    surface_targets: TargetSampler,
+    /// Targets in measured (level-set) DNA (production).
+    measured_targets: TargetSampler,
     radii: RadiiSampler,
+    pub(crate) map: SteeringMap,
+}
+
+/// Which target distribution a candidate draws from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Mode {
+    /// The parents' surface DNA, steered directly (the pilot).
+    Pilot,
+    /// The parents' measured DNA, mapped into surface measure through the
+    /// [`SteeringMap`].
+    Production,
+}
+
+/// The affine map from the surface DNA of a clone to the DNA measured on
+/// its level set, fitted on pilot clones ([`crate::Params::pilot_clones`]),
+/// per target descriptor ([`TARGETS`] order): `measured ≈ offset + slope ·
+/// surface`, with the residual standard deviation.
+///
+/// A measured-space target `m*` is first pulled towards the parents' mean
+/// by `shrink = √(1 − σ_res² / σ_parents²)` — so that the residual scatter
+/// added on the way from surface to level set does not widen the clones'
+/// distribution — and then steered as the surface target
+/// `(m* − offset) / slope`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SteeringMap {
+    /// Offsets.
+    pub offset: [f64; 5],
+    /// Slopes (> 0).
+    pub slope: [f64; 5],
+    /// Residual standard deviations of the fit.
+    pub residual_sd: [f64; 5],
+    /// Parents' measured means.
+    pub parent_mean: [f64; 5],
+    /// Variance-preserving pull factors in (0, 1].
+    pub shrink: [f64; 5],
+    /// Pilot clones the map was fitted on (0: identity map).
+    pub pilot_clones: usize,
+}
+
+impl SteeringMap {
+    fn identity(parent_mean: [f64; 5]) -> Self {
+        Self {
+            offset: [0.0; 5],
+            slope: [1.0; 5],
+            residual_sd: [0.0; 5],
+            parent_mean,
+            shrink: [1.0; 5],
+            pilot_clones: 0,
+        }
+    }
+
+    /// The surface-measure target of a measured-space target.
+    pub fn steer(&self, measured: &Targets) -> Targets {
+        let m = measured.to_array();
+        let mut out = [0.0; 5];
+        for k in 0..5 {
+            let pulled = self.parent_mean[k] + self.shrink[k] * (m[k] - self.parent_mean[k]);
+            out[k] = (pulled - self.offset[k]) / self.slope[k];
+        }
+        Targets::from_array(out)
+    }
 }
 
 fn check_spread(what: &'static str, x: &[f64]) -> Result<()> {
@@ -201,7 +356,7 @@ fn check_spread(what: &'static str, x: &[f64]) -> Result<()> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return Err(Error::ConstantParents { what, value: lo });
     }
     Ok(())
@@ -299,30 +454,20 @@ impl CloneModel {
             check_spread(d.name(), c)?;
         }
         let bins = params.bins;
-        let targets = match params.targets {
-            TargetModel::Copula => TargetSampler::Copula(GaussianCopula::fit(
-                &DnaTable::from_columns(TARGETS.to_vec(), cols.clone())?,
-            )?),
-            TargetModel::Seed => {
-                let pdf = |x: &[f64], y: &[f64]| -> Result<AcceptanceRejection2d<BicubicPdf>> {
-                    let h = Histogram2d::new(x, y, (bins, bins), None, None)?;
-                    Ok(AcceptanceRejection2d::new(BicubicPdf::from_histogram(
-                        &h, 4,
-                    )?)?)
-                };
-                let one = |x: &[f64]| -> Result<InverseCdfSampler1d> {
-                    Ok(InverseCdfSampler1d::from_histogram(&Histogram1d::new(
-                        x, bins, None,
-                    )?)?)
-                };
-                TargetSampler::Seed {
-                    ar_s: pdf(&cols[0], &cols[1])?,
-                    s_vs: pdf(&cols[1], &cols[4])?,
-                    flatness: one(&cols[2])?,
-                    roundness: one(&cols[3])?,
-                }
-            }
-        };
+        let surface_targets = target_sampler(params.targets, &cols, bins)?;
+        let measured_cols: Vec<Vec<f64>> = TARGET_IN_DNA
+            .iter()
+            .map(|&k| parents.dna.columns()[k].clone())
+            .collect();
+        for (d, c) in TARGETS.iter().zip(&measured_cols) {
+            check_spread(d.name(), c)?;
+        }
+        let measured_targets = target_sampler(params.targets, &measured_cols, bins)?;
+        let parent_mean = std::array::from_fn(|k| {
+            measured_cols[k].iter().sum::<f64>() / measured_cols[k].len() as f64
+        });
+        let parent_sd: [f64; 5] =
+            std::array::from_fn(|k| morph_dna::stats::sample_std(&measured_cols[k]).unwrap_or(0.0));
         // normalised radii ρ = r / r_ellipsoid per node
         let rho: Vec<Vec<f64>> = profiles
             .iter()
@@ -381,14 +526,95 @@ impl CloneModel {
                 }
             }
         };
-        Ok(Self {
+        let mut model = Self {
             params: *params,
             geom,
             surface,
             profiles,
-            targets,
+            surface_targets,
+            measured_targets,
             radii,
-        })
+            map: SteeringMap::identity(parent_mean),
+        };
+        if params.pilot_clones > 0 {
+            model.map = model.fit_steering_map(parent_mean, parent_sd)?;
+        }
+        Ok(model)
+    }
+
+    /// Pilot clones on reserved streams (`u64::MAX − i`), steered in surface
+    /// measure, measured on their level sets; least-squares fit of measured
+    /// on surface DNA per target descriptor.
+    fn fit_steering_map(&self, parent_mean: [f64; 5], parent_sd: [f64; 5]) -> Result<SteeringMap> {
+        let k = self.params.pilot_clones as u64;
+        let pairs: Vec<Result<([f64; 5], [f64; 5])>> = (0..k)
+            .into_par_iter()
+            .map(|i| {
+                let (c, _) = self.clone_with(
+                    u64::MAX - i,
+                    Mode::Pilot,
+                    crate::params::Outputs {
+                        level_set: false,
+                        dna: true,
+                    },
+                    &crate::pipeline::NoClock,
+                )?;
+                let s = c.surface;
+                let surf = [
+                    s.aspect_ratio(),
+                    s.dims[2],
+                    s.flatness(),
+                    s.roundness,
+                    s.volume_surface_ratio(),
+                ];
+                let d = c.dna.unwrap_or_default();
+                let meas =
+                    std::array::from_fn(|t| d.get(TARGET_IN_DNA[t]).copied().unwrap_or(f64::NAN));
+                Ok((surf, meas))
+            })
+            .collect();
+        let pairs = pairs.into_iter().collect::<Result<Vec<_>>>()?;
+        let mut map = SteeringMap::identity(parent_mean);
+        map.pilot_clones = pairs.len();
+        #[allow(clippy::needless_range_loop)] // t indexes five parallel arrays
+        for t in 0..5 {
+            let x: Vec<f64> = pairs.iter().map(|p| p.0[t]).collect();
+            let y: Vec<f64> = pairs.iter().map(|p| p.1[t]).collect();
+            let n = x.len() as f64;
+            let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+            let sxx: f64 = x.iter().map(|v| (v - mx) * (v - mx)).sum();
+            let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
+            let slope = sxy / sxx;
+            if !(slope.is_finite() && slope > 0.05) {
+                return Err(Error::InvalidParameter {
+                    name: "pilot_clones",
+                    value: n,
+                    reason: "pilot clones whose measured DNA rises with their surface DNA (fit failed)",
+                });
+            }
+            let offset = my - slope * mx;
+            let ss: f64 = x
+                .iter()
+                .zip(&y)
+                .map(|(a, b)| (b - offset - slope * a).powi(2))
+                .sum();
+            let res = (ss / (n - 2.0).max(1.0)).sqrt();
+            map.offset[t] = offset;
+            map.slope[t] = slope;
+            map.residual_sd[t] = res;
+            let ratio = if parent_sd[t] > 0.0 {
+                res / parent_sd[t]
+            } else {
+                0.0
+            };
+            map.shrink[t] = (1.0 - ratio * ratio).max(0.25).sqrt();
+        }
+        Ok(map)
+    }
+
+    /// The fitted steering map (identity without pilot clones).
+    pub fn steering_map(&self) -> &SteeringMap {
+        &self.map
     }
 
     /// The parameters the model was fitted with.
@@ -411,39 +637,29 @@ impl CloneModel {
         &self.profiles
     }
 
-    /// Draws the targets of one candidate.
+    /// Draws the targets of one candidate: `(measured-space targets,
+    /// surface-measure steering targets)`; in the pilot both are the
+    /// surface targets.
     pub(crate) fn sample_targets(
         &self,
+        mode: Mode,
         rng: &mut impl Rng,
-    ) -> std::result::Result<Targets, TargetUnavailable> {
-        match &self.targets {
-            TargetSampler::Copula(c) => {
-                let v = c.sample(rng);
-                Ok(Targets {
-                    aspect_ratio: v[0],
-                    min_dimension: v[1],
-                    flatness: v[2].max(v[0]),
-                    roundness: v[3],
-                    volume_surface_ratio: v[4],
-                })
+    ) -> std::result::Result<(Targets, Targets), TargetUnavailable> {
+        match mode {
+            Mode::Pilot => {
+                let t = self.surface_targets.sample(rng)?;
+                Ok((t, t))
             }
-            TargetSampler::Seed {
-                ar_s,
-                s_vs,
-                flatness,
-                roundness,
-            } => {
-                let (ar, s) = ar_s.sample(rng);
-                let vs = s_vs
-                    .sample_y_given_x(s, 100_000, rng)
-                    .map_err(|_| TargetUnavailable)?;
-                Ok(Targets {
-                    aspect_ratio: ar,
-                    min_dimension: s,
-                    flatness: flatness.sample(rng).max(ar),
-                    roundness: roundness.sample(rng),
-                    volume_surface_ratio: vs,
-                })
+            Mode::Production => {
+                let t = self.measured_targets.sample(rng)?;
+                let mut s = self.map.steer(&t);
+                s.flatness = s.flatness.max(s.aspect_ratio);
+                // a roundness beyond 1 is met by the smoothest surface
+                s.roundness = s.roundness.min(1.0);
+                if s.to_array().iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+                    return Err(TargetUnavailable);
+                }
+                Ok((t, s))
             }
         }
     }

@@ -62,6 +62,9 @@ pub struct Smoothing {
     /// Iterations after which a candidate that is still too sharp is
     /// rejected (≥ 1).
     pub max_iterations: usize,
+    /// Inverse (sharpening) steps allowed for a candidate rounder than its
+    /// target before it is rejected (0 = the seed: rejected at once).
+    pub max_sharpening: usize,
 }
 
 impl Default for Smoothing {
@@ -69,6 +72,7 @@ impl Default for Smoothing {
         Self {
             lambda: 0.5,
             max_iterations: 64,
+            max_sharpening: 8,
         }
     }
 }
@@ -119,6 +123,14 @@ pub struct Params {
     /// that the surface's principal dimensions meet the sampled ones (0 = the
     /// seed, which keeps the embryo's axes).
     pub axis_corrections: usize,
+    /// Pilot clones (on reserved streams) that calibrate the map from the
+    /// cheap surface DNA to the DNA measured on level sets, so targets can be
+    /// drawn from the parents' measured DNA (0 = no pilot: measured targets
+    /// are steered as if the two measures agreed, as the seed does).
+    pub pilot_clones: usize,
+    /// Radii fields tried for one draw of the targets before the targets are
+    /// redrawn (1 = the seed: a rejected grain is discarded whole).
+    pub fields_per_target: usize,
     /// Candidates per clone index before [`Error::TooManyRejections`].
     pub max_attempts: usize,
     /// Master seed; clone `i` uses the stream `(seed, i)`.
@@ -140,6 +152,8 @@ impl Default for Params {
             radii: RadiiModel::default(),
             interpolation: Interpolation::default(),
             axis_corrections: 2,
+            pilot_clones: 96,
+            fields_per_target: 64,
             max_attempts: 20_000,
             seed: 2018,
             outputs: Outputs::default(),
@@ -157,6 +171,12 @@ impl Params {
             radii: RadiiModel::SeedNeighbourhood,
             interpolation: Interpolation::Bilinear,
             axis_corrections: 0,
+            pilot_clones: 0,
+            fields_per_target: 1,
+            smoothing: Smoothing {
+                max_sharpening: 0,
+                ..Smoothing::default()
+            },
             ..Self::default()
         }
     }
@@ -214,6 +234,13 @@ impl Params {
                 "between 1 and 100000",
             );
         }
+        if s.max_sharpening > 1000 {
+            return bad(
+                "smoothing.max_sharpening",
+                s.max_sharpening as f64,
+                "at most 1000",
+            );
+        }
         if let RadiiModel::CopulaField { shrinkage } = self.radii
             && !(shrinkage.is_finite() && (0.0..1.0).contains(&shrinkage))
         {
@@ -225,6 +252,16 @@ impl Params {
                 self.axis_corrections as f64,
                 "at most 100",
             );
+        }
+        if self.pilot_clones != 0 && !(8..=100_000).contains(&self.pilot_clones) {
+            return bad(
+                "pilot_clones",
+                self.pilot_clones as f64,
+                "0, or between 8 and 100000",
+            );
+        }
+        if self.fields_per_target == 0 {
+            return bad("fields_per_target", 0.0, "at least 1");
         }
         if self.max_attempts == 0 {
             return bad("max_attempts", 0.0, "at least 1");

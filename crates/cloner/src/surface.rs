@@ -66,8 +66,8 @@ pub struct MeshGeometry {
     dirs: Vec<Vector3<f64>>,
     /// Solid angle of every node's cell.
     weights: Vec<f64>,
-    /// Per node: (θ, φ).
-    angles: Vec<(f64, f64)>,
+    /// Per node: `[u_θ, u_φ, u_θφ, u_φφ]` and `1/sin²θ` (rings only).
+    frames: Vec<([Vector3<f64>; 4], f64)>,
     /// Ring nodes: [i+1, i−1, j+1, j−1] neighbours (poles: unused).
     nbrs: Vec<[usize; 4]>,
     /// Ring nodes: [(i+1, j+1), (i−1, j+1), (i+1, j−1), (i−1, j−1)].
@@ -158,13 +158,29 @@ impl MeshGeometry {
                 ];
             }
         }
+        let frames = angles
+            .iter()
+            .map(|&(t, p)| {
+                let (st, ct) = t.sin_cos();
+                let (sp, cp) = p.sin_cos();
+                (
+                    [
+                        Vector3::new(ct * cp, ct * sp, -st),
+                        Vector3::new(-st * sp, st * cp, 0.0),
+                        Vector3::new(-ct * sp, ct * cp, 0.0),
+                        Vector3::new(-st * cp, -st * sp, 0.0),
+                    ],
+                    if st > 0.0 { 1.0 / (st * st) } else { 0.0 },
+                )
+            })
+            .collect();
         Self {
             mesh,
             dtheta,
             dphi,
             dirs,
             weights,
-            angles,
+            frames,
             nbrs,
             diag,
         }
@@ -239,16 +255,10 @@ impl MeshGeometry {
 
     /// Area element factor and largest principal curvature at ring node `f`.
     fn ring_geometry(&self, r: &[f64], f: usize) -> (f64, f64) {
-        let (t, p) = self.angles[f];
-        let (st, ct) = t.sin_cos();
-        let (sp, cp) = p.sin_cos();
+        let ([ut, up, utp, upp], inv_s2) = self.frames[f];
         let [rt, rp, rtt, rpp, rtp] = self.derivatives(r, f);
         let rr = r[f];
         let u = self.dirs[f];
-        let ut = Vector3::new(ct * cp, ct * sp, -st);
-        let up = Vector3::new(-st * sp, st * cp, 0.0);
-        let utp = Vector3::new(-ct * sp, ct * cp, 0.0);
-        let upp = Vector3::new(-st * cp, -st * sp, 0.0);
         let xt = rt * u + rr * ut;
         let xp = rp * u + rr * up;
         let xtt = rtt * u + 2.0 * rt * ut - rr * u;
@@ -256,8 +266,8 @@ impl MeshGeometry {
         let xpp = rpp * u + 2.0 * rp * up + rr * upp;
         let cross = xt.cross(&xp);
         let cn = cross.norm();
-        let dens = rr * (rr * rr + rt * rt + rp * rp / (st * st)).sqrt();
-        if !(cn > 0.0) {
+        let dens = rr * (rr * rr + rt * rt + rp * rp * inv_s2).sqrt();
+        if cn.is_nan() || cn <= 0.0 {
             return (dens, 0.0);
         }
         let nrm = cross / cn;

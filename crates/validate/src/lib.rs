@@ -27,6 +27,7 @@
 
 mod error;
 pub mod fixtures;
+pub mod grains;
 mod runner;
 mod tolerance;
 
