@@ -260,10 +260,11 @@ impl Grid {
                             values.extend(std::iter::repeat_n(FAR, nx));
                             continue;
                         }
-                        for i in 0..nx {
+                        // `extend` over a range: no capacity check per node.
+                        values.extend((0..nx).map(|i| {
                             let x = o.x + h * i as f64;
                             let rho2 = x * x + yz2;
-                            values.push(if rho2 < inner2 {
+                            if rho2 < inner2 {
                                 -FAR
                             } else if rho2 > outer2 {
                                 FAR
@@ -271,8 +272,8 @@ impl Grid {
                                 rho2.sqrt() - map.radius(&Vector3::new(x, y, z))
                             } else {
                                 -map.radius(&Vector3::z())
-                            });
-                        }
+                            }
+                        }));
                     }
                 }
             }
@@ -322,7 +323,8 @@ impl Grid {
 }
 
 /// Second-order distance estimate from the radial distance `g` at an interior node with
-/// linear index `c` (strides 1, `sy`, `sz`), or NaN if the stencil holds a far marker, the
+/// in-slab index `c` (strides 1, `sy`; `lo`, `mid`, `up` = the z-slabs below, at and above
+/// the node), or NaN if the stencil holds a far marker, the
 /// first-order estimate is not below `√cut2`, or a guard fails.
 ///
 /// Along the surface normal through the node, `g(t) = a·t + b·t²/2 + O(t³)` with
@@ -331,11 +333,17 @@ impl Grid {
 /// third-order otherwise (the first-order `g/|∇g|` of the seed errs by `b·d²/2`).
 /// Derivatives are central differences.
 #[inline]
-fn second_order_distance(g: &[f64], c: usize, sy: usize, sz: usize, h: f64, cut2: f64) -> f64 {
-    let v = g[c];
-    let (xl, xr) = (g[c - 1], g[c + 1]);
-    let (yl, yr) = (g[c - sy], g[c + sy]);
-    let (zl, zr) = (g[c - sz], g[c + sz]);
+fn second_order_distance(
+    [lo, mid, up]: [&[f64]; 3],
+    c: usize,
+    sy: usize,
+    h: f64,
+    cut2: f64,
+) -> f64 {
+    let v = mid[c];
+    let (xl, xr) = (mid[c - 1], mid[c + 1]);
+    let (yl, yr) = (mid[c - sy], mid[c + sy]);
+    let (zl, zr) = (lo[c], up[c]);
     let inv2h = 0.5 / h;
     let gx = (xr - xl) * inv2h;
     let gy = (yr - yl) * inv2h;
@@ -352,9 +360,9 @@ fn second_order_distance(g: &[f64], c: usize, sy: usize, sz: usize, h: f64, cut2
     let hyy = (yl - 2.0 * v + yr) * ih2;
     let hzz = (zl - 2.0 * v + zr) * ih2;
     let q = 0.25 * ih2;
-    let hxy = (g[c + 1 + sy] - g[c + 1 - sy] - g[c - 1 + sy] + g[c - 1 - sy]) * q;
-    let hxz = (g[c + 1 + sz] - g[c + 1 - sz] - g[c - 1 + sz] + g[c - 1 - sz]) * q;
-    let hyz = (g[c + sy + sz] - g[c + sy - sz] - g[c - sy + sz] + g[c - sy - sz]) * q;
+    let hxy = (mid[c + 1 + sy] - mid[c + 1 - sy] - mid[c - 1 + sy] + mid[c - 1 - sy]) * q;
+    let hxz = (up[c + 1] - lo[c + 1] - up[c - 1] + lo[c - 1]) * q;
+    let hyz = (up[c + sy] - lo[c + sy] - up[c - sy] + lo[c - sy]) * q;
     let b = (gx * gx * hxx
         + gy * gy * hyy
         + gz * gz * hzz
@@ -385,6 +393,21 @@ fn band_redistance(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64], rmax: f
     Ok(())
 }
 
+/// Membership bits of the band nodes (one bit per node).
+struct Band(Vec<u64>);
+
+impl Band {
+    #[inline]
+    fn has(&self, c: usize) -> bool {
+        self.0[c / 64] >> (c % 64) & 1 == 1
+    }
+    #[inline]
+    fn set(&mut self, c: usize, on: bool) {
+        let (w, b) = (c / 64, c % 64);
+        self.0[w] = (self.0[w] & !(1 << b)) | (u64::from(on) << b);
+    }
+}
+
 /// Whether some pair of neighbouring nodes differs in sign.
 fn crosses(spec: &GridSpec, g: &[f64]) -> bool {
     let [nx, ny, nz] = spec.dims;
@@ -407,53 +430,71 @@ fn crosses(spec: &GridSpec, g: &[f64]) -> bool {
     false
 }
 
-/// Second-order distances of the band nodes (NaN elsewhere).
+/// Writes the second-order distances of the band nodes over the radial field `g` (other
+/// nodes keep their radial value) and returns the band membership. The stencils read the
+/// radial field: two copies of z-slabs keep the original values of the slabs already
+/// overwritten.
 #[inline(never)]
-fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f32> {
+fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
     let [nx, ny, nz] = spec.dims;
     let h = spec.spacing;
-    let (sy, sz) = (nx, nx * ny);
+    let sy = nx;
+    let plane = nx * ny;
     let band_w = BAND_CELLS * h;
     let o = spec.origin.coords - centre.coords;
     let cut2 = (1.15 * band_w).powi(2);
-    // f32 storage halves the memory traffic; its rounding (≈ 1e-8·h) is far below the
-    // estimate's error.
-    let mut band = vec![f32::NAN; g.len()];
+    let mut band = Band(vec![0; g.len().div_ceil(64)]);
+    let mut lo = g[..plane].to_vec();
+    let mut mid = vec![0.0; plane];
+    let mut found = Vec::new();
     for k in 1..nz - 1 {
-        for j in 1..ny - 1 {
-            let row = sy * j + sz * k;
-            let (y, z) = (o.y + h * j as f64, o.z + h * k as f64);
-            let yz2 = y * y + z * z;
-            for i in 1..nx - 1 {
-                let c = row + i;
-                let v = g[c];
-                // The radial field is singular at the centre: the expansion is trusted only
-                // where the node is farther from the centre than from the surface along its
-                // ray (|g| ≤ ρ; this excludes band nodes deeper than r/2 in grains thinner
-                // than 2·BAND_CELLS cells, which then take far-field values). Far markers
-                // (±∞) fail the test too.
-                // Cheap screen first: the first-order estimate |g|/|∇g| with |∇g| ≤ 2 must be
-                // below 1.15 band widths (a node needing a larger second-order correction
-                // takes the far field).
-                if v * v >= 4.0 * cut2 {
-                    continue;
-                }
-                let x = o.x + h * i as f64;
-                if v * v > x * x + yz2 {
-                    continue;
-                }
-                let d = second_order_distance(g, c, sy, sz, h, cut2);
-                if d.abs() < band_w {
-                    band[c] = d as f32;
+        mid.copy_from_slice(&g[plane * k..plane * (k + 1)]);
+        found.clear();
+        {
+            let up = &g[plane * (k + 1)..plane * (k + 2)];
+            let z = o.z + h * k as f64;
+            for j in 1..ny - 1 {
+                let row = sy * j;
+                let y = o.y + h * j as f64;
+                let yz2 = y * y + z * z;
+                for i in 1..nx - 1 {
+                    let c = row + i;
+                    let v = mid[c];
+                    // Cheap screen first: the first-order estimate |g|/|∇g| with |∇g| ≤ 2
+                    // must be below 1.15 band widths (a node needing a larger second-order
+                    // correction takes the far field).
+                    if v * v >= 4.0 * cut2 {
+                        continue;
+                    }
+                    // The radial field is singular at the centre: the expansion is trusted
+                    // only where the node is farther from the centre than from the surface
+                    // along its ray (|g| ≤ ρ; this excludes band nodes deeper than r/2 in
+                    // grains thinner than 2·BAND_CELLS cells, which then take far-field
+                    // values).
+                    let x = o.x + h * i as f64;
+                    if v * v > x * x + yz2 {
+                        continue;
+                    }
+                    let d = second_order_distance([&lo, &mid, up], c, sy, h, cut2);
+                    if d.abs() < band_w {
+                        found.push((c, d));
+                    }
                 }
             }
         }
+        for &(c, d) in &found {
+            g[plane * k + c] = d;
+            band.set(plane * k + c, true);
+        }
+        std::mem::swap(&mut lo, &mut mid);
     }
     // Consistency check: near a ridge of the distance (the medial axis, which reaches the
     // surface at convex kinks of r), the expansion can err without its guards noticing;
-    // there the band values break |∇φ| = 1. An interior band node whose six neighbours are band nodes
-    // and whose central-difference gradient norm is off by more than EIKONAL_SLACK leaves
-    // the band (one pass, on the values before the pass).
+    // there the band values break |∇φ| = 1. An interior band node whose six neighbours are
+    // band nodes and whose central-difference gradient norm is off by more than
+    // EIKONAL_SLACK leaves the band (one pass, on the values before the pass; it keeps its
+    // band value, whose sign is the radial one, for the far field to replace).
+    let sz = plane;
     let mut demote = Vec::new();
     let (lo2, hi2) = (
         (1.0 - EIKONAL_SLACK).powi(2) * 4.0 * h * h,
@@ -465,14 +506,17 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f32> {
             for i in 1..nx - 1 {
                 let c = row + i;
                 // Outside, the far field is only a bound: exterior band values are kept.
-                if band[c].is_nan() || band[c] >= 0.0 {
+                if !band.has(c) || g[c] >= 0.0 {
                     continue;
                 }
-                let gx = f64::from(band[c + 1]) - f64::from(band[c - 1]);
-                let gy = f64::from(band[c + sy]) - f64::from(band[c - sy]);
-                let gz = f64::from(band[c + sz]) - f64::from(band[c - sz]);
+                let nb = [c - 1, c + 1, c - sy, c + sy, c - sz, c + sz];
+                if !nb.iter().all(|&q| band.has(q)) {
+                    continue;
+                }
+                let gx = g[c + 1] - g[c - 1];
+                let gy = g[c + sy] - g[c - sy];
+                let gz = g[c + sz] - g[c - sz];
                 let n2 = gx * gx + gy * gy + gz * gz;
-                // NaN (a neighbour outside the band) fails both comparisons: kept.
                 if n2 > hi2 || n2 < lo2 {
                     demote.push(c);
                 }
@@ -480,7 +524,7 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &[f64]) -> Vec<f32> {
         }
     }
     for c in demote {
-        band[c] = f32::NAN;
+        band.set(c, false);
     }
     band
 }
@@ -512,7 +556,7 @@ impl Coarse {
         spec: &GridSpec,
         centre: &Point3<f64>,
         g: &[f64],
-        band: &[f32],
+        band: &Band,
         rmax: f64,
     ) -> Result<Self> {
         let [nx, ny, nz] = spec.dims;
@@ -546,10 +590,20 @@ impl Coarse {
                     // Nodes beyond the grid take the sign of the last grid node.
                     let (i, j, k) = (2 * ic, 2 * jc, 2 * kc);
                     let c = i.min(nx - 1) + sy * j.min(ny - 1) + sz * k.min(nz - 1);
-                    let d = f64::from(band[c]);
-                    let inside = g[c] < 0.0;
-                    if i < nx && j < ny && k < nz && d.abs() <= SOURCE_CELLS * h {
-                        // Band nodes are interior nodes, so the stencil exists.
+                    let d = g[c];
+                    let inside = d < 0.0;
+                    // A source: a band node within SOURCE_CELLS·h whose six neighbours are band
+                    // nodes (band nodes are interior nodes, so they exist), the normal being
+                    // the gradient of the band distance.
+                    let source = i < nx
+                        && j < ny
+                        && k < nz
+                        && band.has(c)
+                        && d.abs() <= SOURCE_CELLS * h
+                        && [c - 1, c + 1, c - sy, c + sy, c - sz, c + sz]
+                            .iter()
+                            .all(|&q| band.has(q));
+                    if source {
                         let grad = Vector3::new(
                             (g[c + 1] - g[c - 1]) * inv2h,
                             (g[c + sy] - g[c - sy]) * inv2h,
@@ -639,7 +693,7 @@ impl Coarse {
         spec: &GridSpec,
         centre: &Point3<f64>,
         g: &mut [f64],
-        band: &[f32],
+        band: &Band,
         rmax: f64,
     ) {
         let [nx, ny, nz] = spec.dims;
@@ -684,12 +738,12 @@ impl Coarse {
                 ];
                 for i in 0..nx {
                     let c = dst + i;
-                    let b = f64::from(band[c]);
-                    let inside = g[c] < 0.0;
+                    let b = g[c];
+                    let in_band = band.has(c);
+                    let inside = b < 0.0;
                     // Band values within the sources, and outside (where the far field is
                     // only a bound), are kept.
-                    if b.abs() <= SOURCE_CELLS * h || (b.is_finite() && !inside) {
-                        g[c] = b;
+                    if in_band && (b.abs() <= SOURCE_CELLS * h || !inside) {
                         continue;
                     }
                     if !inside {
@@ -705,11 +759,9 @@ impl Coarse {
                     // (robust near ridges, where an expansion can underestimate); an
                     // interpolated value of the other sign (next to the surface) is small, and
                     // only its magnitude is kept.
-                    g[c] = if (b - interp).abs() <= AGREEMENT * h {
-                        b
-                    } else {
-                        -interp.abs()
-                    };
+                    if !(in_band && (b - interp).abs() <= AGREEMENT * h) {
+                        g[c] = -interp.abs();
+                    }
                 }
             }
         }
