@@ -26,13 +26,11 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use cloner::{CloneModel, Hooks, Params, Parents, Progress, RunStats, TABLES_4_5};
-use levelset::Grid;
-use morph_dna::{
-    CorrelationMethod, Descriptor, DnaTable, GradingCurve, GradingInterpolation, GradingWeight,
-    MeasureParams, SphericalMesh, compare_populations,
+use cloner::{
+    Calibrated, CloneModel, Hooks, Params, Parents, Progress, RunStats, Scores, TABLES_4_5, score,
 };
-use serde::{Deserialize, Serialize};
+use levelset::Grid;
+use morph_dna::{Descriptor, DnaTable, GradingCurve, GradingWeight, MeasureParams, SphericalMesh};
 
 use crate::svg;
 
@@ -87,47 +85,9 @@ struct Config {
     params: Params,
 }
 
-/// Scores of one configuration.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub(crate) struct Scores {
-    /// Mean errors (%) in Tables 4–5 order.
-    pub(crate) mean_error_pct: [f64; 4],
-    /// Standard-deviation errors (%).
-    pub(crate) std_error_pct: [f64; 4],
-    /// KS distances.
-    pub(crate) ks: [f64; 4],
-    /// Averages.
-    pub(crate) mean_error_avg_pct: f64,
-    /// Average standard-deviation error (%).
-    pub(crate) std_error_avg_pct: f64,
-    /// Largest KS distance.
-    pub(crate) ks_max: f64,
-    /// Grading coefficients (Cu, Cc) of parents and clones.
-    pub(crate) cu_cc_parents: [f64; 2],
-    /// Clones' (Cu, Cc).
-    pub(crate) cu_cc_clones: [f64; 2],
-}
-
-/// The committed calibration.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub(crate) struct Calibrated {
-    /// Name of the chosen configuration.
-    pub(crate) name: String,
-    /// Its parameters.
-    pub(crate) params: Params,
-    /// Clones scored.
-    pub(crate) clones: u64,
-    /// Parents.
-    pub(crate) parents: usize,
-    /// Scores.
-    pub(crate) scores: Scores,
-    /// Candidates drawn for those clones.
-    pub(crate) attempts: u64,
-}
-
 struct Outcome {
     config: Config,
-    map: cloner::model::SteeringMap,
+    map: cloner::SteeringMap,
     steering: String,
     scores: Scores,
     stats: RunStats,
@@ -215,46 +175,6 @@ fn load_parents() -> anyhow::Result<(Parents, Vec<String>)> {
         Parents::from_grids(grids, &MeasureParams::default())?,
         names,
     ))
-}
-
-fn grading(dna: &DnaTable) -> anyhow::Result<[f64; 2]> {
-    let d = dna.column(Descriptor::EquivalentDiameter)?;
-    let g = GradingCurve::from_diameters(d, GradingWeight::Volume)?;
-    let c = g.coefficients(GradingInterpolation::LogDiameter)?;
-    Ok([c.cu, c.cc])
-}
-
-fn score(parents: &DnaTable, clones: &DnaTable) -> anyhow::Result<Scores> {
-    let cmp = compare_populations(parents, clones, &TABLES_4_5, CorrelationMethod::Pearson)?;
-    let mut mean = [0.0; 4];
-    let mut std = [0.0; 4];
-    let mut ks = [0.0; 4];
-    for (k, d) in TABLES_4_5.iter().enumerate() {
-        let e = cmp
-            .errors
-            .rows
-            .iter()
-            .find(|r| r.descriptor == *d)
-            .context("error row")?;
-        mean[k] = e.mean_error_pct;
-        std[k] = e.std_error_pct;
-        ks[k] = cmp
-            .distances
-            .iter()
-            .find(|x| x.descriptor == *d)
-            .context("distance row")?
-            .ks;
-    }
-    Ok(Scores {
-        mean_error_avg_pct: mean.iter().sum::<f64>() / 4.0,
-        std_error_avg_pct: std.iter().sum::<f64>() / 4.0,
-        ks_max: ks.iter().fold(0.0f64, |a, b| a.max(*b)),
-        mean_error_pct: mean,
-        std_error_pct: std,
-        ks,
-        cu_cc_parents: grading(parents)?,
-        cu_cc_clones: grading(clones)?,
-    })
 }
 
 fn progress_bar(label: &str) -> impl Fn(Progress) + Sync + '_ {
@@ -722,7 +642,7 @@ impl Calibrate {
                 scores: b.scores.clone(),
                 attempts: b.stats.attempts,
             };
-            let text = ron::ser::to_string_pretty(&cal, ron::ser::PrettyConfig::default())?;
+            let text = cal.to_ron()?;
             let path = root.join(FIXTURE);
             std::fs::write(&path, text + "\n")
                 .with_context(|| format!("writing {}", path.display()))?;
@@ -740,8 +660,8 @@ impl Calibrate {
         let path = root.join(FIXTURE);
         let text = std::fs::read_to_string(&path)
             .with_context(|| format!("reading {}", path.display()))?;
-        let cal: Calibrated =
-            ron::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+        let cal =
+            Calibrated::from_ron(&text).with_context(|| format!("parsing {}", path.display()))?;
         let config = Config {
             name: cal.name.clone(),
             trial: None,

@@ -90,6 +90,7 @@
 //!
 //! Layer 2: depends on `morph-dna`, `levelset` (and may use `sph-harmonics`).
 
+pub mod calibration;
 pub mod error;
 pub mod model;
 pub mod output;
@@ -97,9 +98,10 @@ pub mod params;
 pub mod pipeline;
 pub mod surface;
 
+pub use calibration::{Calibrated, Scores, score};
 pub use error::{Error, Result};
 pub use model::{
-    CloneModel, DNA, MIN_PARENTS, Parents, TABLES_4_5, TARGETS, Targets, grid_from_sh,
+    CloneModel, DNA, MIN_PARENTS, Parents, SteeringMap, TABLES_4_5, TARGETS, Targets, grid_from_sh,
 };
 pub use output::{Format, write_grid};
 pub use params::{Outputs, Params, RadiiModel, Smoothing, TargetModel};

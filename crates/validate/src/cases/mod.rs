@@ -3,6 +3,7 @@
 
 use crate::{Case, ExpectedFailure};
 
+mod cloner;
 mod fixture_integrity;
 mod levelset;
 mod packer_quadtree;
@@ -13,6 +14,7 @@ mod sph_harmonics;
 #[must_use]
 pub fn registry() -> Vec<Case> {
     let mut cases = Vec::new();
+    cases.extend(cloner::cases());
     cases.extend(fixture_integrity::cases());
     cases.extend(levelset::cases());
     cases.extend(packer_quadtree::cases());
@@ -24,6 +26,7 @@ pub fn registry() -> Vec<Case> {
 #[must_use]
 pub fn expected_failures() -> Vec<ExpectedFailure> {
     let mut list = Vec::new();
+    list.extend_from_slice(cloner::EXPECTED_FAILURES);
     list.extend_from_slice(fixture_integrity::EXPECTED_FAILURES);
     list.extend_from_slice(levelset::EXPECTED_FAILURES);
     list.extend_from_slice(packer_quadtree::EXPECTED_FAILURES);

@@ -1,0 +1,116 @@
+//! cloner reproductions: GSC 2.0 clones of the shipped Ottawa-sand parents
+//! at the calibrated configuration (`fixtures/calibrated/gsc2-ottawa.ron`,
+//! written by `cargo xtask calibrate`) against Medina 2018, Tables 4–5,
+//! trial 4 (the seed's best), and against the issue's targets (average mean
+//! error ≤ 2 %, average standard-deviation error ≤ 10 %, every KS ≤ 0.08).
+//! The run is deterministic, so it must also reproduce the committed scores.
+
+use cloner::{Calibrated, CloneModel, Hooks, Parents, TABLES_4_5, grid_from_sh, score};
+use morph_dna::MeasureParams;
+
+use crate::fixtures::{self, Table};
+use crate::{Case, Check, Error, ExpectedFailure, Tolerance};
+
+const CALIBRATED: &str = "gsc2-ottawa.ron";
+
+pub(crate) fn cases() -> Vec<Case> {
+    vec![Case {
+        name: "cloner/gsc2018-trial4-calibrated",
+        description: "GSC 2.0 clones of the 100 Ottawa parents at the calibrated configuration: Tables 4–5 errors ≤ the seed's trial 4; issue targets; committed scores reproduced",
+        fast: false,
+        run: calibrated,
+    }]
+}
+
+pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[];
+
+fn err(e: impl std::fmt::Display) -> Error {
+    Error::Computation {
+        message: e.to_string(),
+    }
+}
+
+fn calibrated() -> Result<Vec<Check>, Error> {
+    let text = fixtures::calibrated_files()
+        .iter()
+        .find(|(n, _)| *n == CALIBRATED)
+        .map(|(_, t)| *t)
+        .ok_or_else(|| Error::MissingFixture {
+            name: format!("calibrated/{CALIBRATED}"),
+        })?;
+    let cal = Calibrated::from_ron(text).map_err(err)?;
+    let grids = crate::grains::ottawa_models()?
+        .iter()
+        .map(|(_, m, _)| grid_from_sh(m, 45, 1.1).map_err(err))
+        .collect::<Result<Vec<_>, _>>()?;
+    let parents = Parents::from_grids(grids, &MeasureParams::default()).map_err(err)?;
+    let model = CloneModel::fit(&parents, &cal.params).map_err(err)?;
+    let run = model.run(0..cal.clones, Hooks::default()).map_err(err)?;
+    let s = score(parents.dna(), &run.dna_table().map_err(err)?).map_err(err)?;
+    let t4 = Table::reference("gsc2018_table4_mean_error_pct.csv")?;
+    let t5 = Table::reference("gsc2018_table5_std_error_pct.csv")?;
+    let mut out = Vec::new();
+    for (k, d) in TABLES_4_5.iter().enumerate() {
+        out.push(Check::new(
+            format!("{d} mean error % <= seed trial 4"),
+            t4.number(k, "trial_4")?,
+            s.mean_error_pct[k],
+            Tolerance::AtMost(0.0),
+        ));
+        out.push(Check::new(
+            format!("{d} std error % <= seed trial 4"),
+            t5.number(k, "trial_4")?,
+            s.std_error_pct[k],
+            Tolerance::AtMost(0.0),
+        ));
+        out.push(Check::new(
+            format!("{d} KS <= 0.08 (target)"),
+            0.08,
+            s.ks[k],
+            Tolerance::AtMost(0.0),
+        ));
+    }
+    out.push(Check::new(
+        "average mean error % <= seed trial 4",
+        t4.number(4, "trial_4")?,
+        s.mean_error_avg_pct,
+        Tolerance::AtMost(0.0),
+    ));
+    out.push(Check::new(
+        "average std error % <= seed trial 4",
+        t5.number(4, "trial_4")?,
+        s.std_error_avg_pct,
+        Tolerance::AtMost(0.0),
+    ));
+    out.push(Check::new(
+        "average mean error % <= 2 (target)",
+        2.0,
+        s.mean_error_avg_pct,
+        Tolerance::AtMost(0.0),
+    ));
+    out.push(Check::new(
+        "average std error % <= 10 (target)",
+        10.0,
+        s.std_error_avg_pct,
+        Tolerance::AtMost(0.0),
+    ));
+    out.push(Check::new(
+        "clones >= 500",
+        500.0,
+        run.clones.len() as f64,
+        Tolerance::AtLeast(0.0),
+    ));
+    out.push(Check::new(
+        "average mean error reproduces the committed calibration",
+        cal.scores.mean_error_avg_pct,
+        s.mean_error_avg_pct,
+        Tolerance::Relative(1e-6),
+    ));
+    out.push(Check::new(
+        "candidates drawn reproduce the committed calibration",
+        cal.attempts as f64,
+        run.stats.attempts as f64,
+        Tolerance::Within(0.0),
+    ));
+    Ok(out)
+}
