@@ -153,6 +153,18 @@ fn sweep(seed: u64) -> Vec<Config> {
             },
         });
     }
+    for (tol, rt) in [(0.02, 0.03), (0.02, 0.02)] {
+        out.push(Config {
+            name: format!("m28x18-b50-ls45-tol{:.0}-rq{:.0}", 100.0 * tol, 100.0 * rt),
+            trial: None,
+            params: Params {
+                tolerance: tol,
+                roundness_tolerance: Some(rt),
+                seed,
+                ..Params::default()
+            },
+        });
+    }
     out.push(Config {
         name: "m28x18-b50-ls45-seed-methods".into(),
         trial: Some(4),
@@ -386,13 +398,14 @@ fn report_md(
     let ms = |ns: u64| ns as f64 * 1e-6 / st.accepted.max(1) as f64;
     let _ = writeln!(
         md,
-        "Candidates: {} for {} clones (acceptance {:.1} %); rejected: {} too round before polishing, {} roundness not reached, {} V/S quality control, {} degenerate, {} target unavailable. Polishing steps per candidate: {:.1}.\n\nStage time per accepted clone (ms): targets {:.3}, radii {:.3}, polishing {:.3}, quality control {:.3}, rasterisation {:.3}, DNA {:.3}.\n",
+        "Candidates: {} for {} clones (acceptance {:.1} %); rejected: {} too round (after sharpening), {} roundness not reached, {} V/S quality control, {} measured roundness, {} degenerate, {} target unavailable. Polishing steps per candidate: {:.1}.\n\nStage time per accepted clone (ms): targets {:.3}, radii {:.3}, polishing {:.3}, quality control {:.3}, rasterisation {:.3}, DNA {:.3}.\n",
         st.attempts,
         st.accepted,
         100.0 * st.acceptance_rate(),
         r.too_round,
         r.roundness_unreached,
         r.quality_control,
+        r.measured_roundness,
         r.degenerate,
         r.target_unavailable,
         st.polishing_steps as f64 / st.attempts.max(1) as f64,

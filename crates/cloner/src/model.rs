@@ -598,7 +598,14 @@ impl CloneModel {
                 .zip(&y)
                 .map(|(a, b)| (b - offset - slope * a).powi(2))
                 .sum();
-            let res = (ss / (n - 2.0).max(1.0)).sqrt();
+            let mut res = (ss / (n - 2.0).max(1.0)).sqrt();
+            // a level-set roundness check truncates the roundness scatter to
+            // ±tolerance (a uniform-like residual of sd ≈ tol / √3)
+            if t == 3
+                && let Some(rt) = self.params.roundness_tolerance
+            {
+                res = res.min(rt / 3f64.sqrt());
+            }
             map.offset[t] = offset;
             map.slope[t] = slope;
             map.residual_sd[t] = res;

@@ -128,6 +128,9 @@ pub struct Params {
     /// drawn from the parents' measured DNA (0 = no pilot: measured targets
     /// are steered as if the two measures agreed, as the seed does).
     pub pilot_clones: usize,
+    /// Largest |measured − target| roundness of an accepted clone, checked on
+    /// its level set (`None` = the surface-DNA steering alone, the default).
+    pub roundness_tolerance: Option<f64>,
     /// Radii fields tried for one draw of the targets before the targets are
     /// redrawn (1 = the seed: a rejected grain is discarded whole).
     pub fields_per_target: usize,
@@ -153,6 +156,7 @@ impl Default for Params {
             interpolation: Interpolation::default(),
             axis_corrections: 2,
             pilot_clones: 96,
+            roundness_tolerance: None,
             fields_per_target: 64,
             max_attempts: 20_000,
             seed: 2018,
@@ -259,6 +263,11 @@ impl Params {
                 self.pilot_clones as f64,
                 "0, or between 8 and 100000",
             );
+        }
+        if let Some(t) = self.roundness_tolerance
+            && !(t.is_finite() && t > 0.0 && t < 1.0)
+        {
+            return bad("roundness_tolerance", t, "in (0, 1)");
         }
         if self.fields_per_target == 0 {
             return bad("fields_per_target", 0.0, "at least 1");

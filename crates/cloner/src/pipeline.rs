@@ -28,7 +28,10 @@
 //! 5. **rasterisation** of accepted candidates (only if a level set or DNA
 //!    was asked for) through `levelset::Grid::from_star`;
 //! 6. **DNA** of the level set through `morph_dna::measure` (only if asked
-//!    for).
+//!    for, or if `roundness_tolerance` is set: then a clone whose measured
+//!    roundness misses its target by more than that is rejected too, which
+//!    removes the scatter between the cheap surface roundness and the
+//!    level-set one at the price of rasterising the rejected candidates).
 //!
 //! Candidates are rejected in this order, so a rejection costs only the
 //! stages before it. The library reads no clock: stage times come from the
@@ -115,6 +118,9 @@ pub struct Rejections {
     pub degenerate: u64,
     /// The V/S quality control.
     pub quality_control: u64,
+    /// The roundness measured on the level set missed its target by more
+    /// than `roundness_tolerance`.
+    pub measured_roundness: u64,
 }
 
 impl Rejections {
@@ -125,6 +131,7 @@ impl Rejections {
             + self.roundness_unreached
             + self.degenerate
             + self.quality_control
+            + self.measured_roundness
     }
 
     fn add(&mut self, o: &Self) {
@@ -133,6 +140,7 @@ impl Rejections {
         self.roundness_unreached += o.roundness_unreached;
         self.degenerate += o.degenerate;
         self.quality_control += o.quality_control;
+        self.measured_roundness += o.measured_roundness;
     }
 }
 
@@ -604,7 +612,12 @@ impl CloneModel {
                 }
             };
             let (mut grid, mut dna) = (None, None);
-            if outputs.level_set || outputs.dna {
+            let check_roundness = match (mode, self.params.roundness_tolerance) {
+                (Mode::Production, Some(t)) => Some(t),
+                _ => None,
+            };
+            let measure_dna = outputs.dna || check_roundness.is_some();
+            if outputs.level_set || measure_dna {
                 let t0 = clock.now_ns();
                 let g = self.rasterise(&cand.radii);
                 let t1 = clock.now_ns();
@@ -613,11 +626,21 @@ impl CloneModel {
                     stats.rejections.degenerate += 1;
                     continue;
                 };
-                if outputs.dna {
+                if measure_dna {
                     let d = measure(&g, &DNA, &MeasureParams::default());
                     stats.times.measure_ns += clock.now_ns() - t1;
                     match d {
-                        Ok(d) => dna = Some(d),
+                        Ok(d) => {
+                            if let Some(t) = check_roundness
+                                && (d[2] - cand.targets.roundness).abs() > t
+                            {
+                                stats.rejections.measured_roundness += 1;
+                                continue;
+                            }
+                            if outputs.dna {
+                                dna = Some(d);
+                            }
+                        }
                         Err(_) => {
                             stats.rejections.degenerate += 1;
                             continue;
