@@ -416,18 +416,22 @@ impl Needs {
 /// of `wanted`.
 ///
 /// Only what `wanted` needs is computed, so a caller asking for a subset
-/// pays for that subset. Costs on a 45³ grid (about 8,000 surface vertices,
-/// one core; see the `descriptors` bench):
+/// pays for that subset; intermediate results are shared between the
+/// descriptors that need them. Costs on a 45³ grid (about 8,000 surface
+/// vertices, one core, measured on a loaded machine; see the `descriptors`
+/// bench):
 ///
 /// * volume, area, volume/surface ratio, equivalent diameter, sphericity:
-///   one pass of exact integration over the zero level set (≈ 0.5 ms);
+///   one pass of exact integration over the zero level set (≈ 0.5–0.8 ms);
 /// * principal dimensions, aspect ratio, elongation, flatness: the same pass
 ///   and a 3 × 3 eigen-decomposition (no extra cost);
-/// * roundness: the marching-cubes surface, curvatures at its vertices and
-///   the inscribed sphere (≈ 1 ms);
-/// * principal extents: the surface (shared with roundness);
-/// * convexity: the surface and the exact convex hull of its vertices, by
-///   far the most expensive descriptor (a few ms).
+/// * roundness: the marching-cubes surface (≈ 0.4 ms), curvatures at its
+///   vertices and the inscribed sphere (≈ 1.2 ms in all);
+/// * principal extents: the surface (shared with roundness and convexity);
+/// * convexity: the surface and the exact convex hull of its vertices
+///   (≈ 3 ms for the hull alone: most surface vertices are hull vertices),
+///   by far the most expensive descriptor; leave it out when it is not
+///   needed.
 ///
 /// # Errors
 /// [`Error::LevelSet`] for a grid without a closed surface (empty, all
