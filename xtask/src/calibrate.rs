@@ -12,8 +12,11 @@
 //!   of the chosen configuration, error against run time of every
 //!   configuration;
 //! * `fixtures/calibrated/gsc2-ottawa.ron` — the chosen configuration and its
-//!   scores (lowest sum of the average mean and average standard-deviation
-//!   errors, the seed's criterion extended to both tables).
+//!   scores: among the configurations that meet the targets (average mean
+//!   error ≤ 2 %, average standard-deviation error ≤ 10 %, every KS ≤ 0.08),
+//!   or among all if none does, the lowest sum of the average mean and
+//!   average standard-deviation errors (the seed's criterion over both
+//!   tables).
 //!
 //! `--check` re-runs the committed configuration and fails unless it
 //! reproduces the committed scores (runs are deterministic).
@@ -153,7 +156,7 @@ fn sweep(seed: u64) -> Vec<Config> {
             },
         });
     }
-    for (tol, rt) in [(0.02, 0.03), (0.02, 0.02)] {
+    for (tol, rt) in [(0.02, 0.03), (0.03, 0.03)] {
         out.push(Config {
             name: format!("m28x18-b50-ls45-tol{:.0}-rq{:.0}", 100.0 * tol, 100.0 * rt),
             trial: None,
@@ -615,12 +618,22 @@ impl Calibrate {
         if outcomes.is_empty() {
             bail!("every configuration failed:\n{}", failed.join("\n"));
         }
+        // the targets first (average mean error <= 2 %, average std
+        // error <= 10 %, every KS <= 0.08), then the lowest sum of the two
+        // averages (the seed's criterion over both tables)
         let best = outcomes
             .iter()
             .enumerate()
             .min_by(|(_, a), (_, b)| {
-                let f = |o: &Outcome| o.scores.mean_error_avg_pct + o.scores.std_error_avg_pct;
-                f(a).total_cmp(&f(b))
+                let key = |o: &Outcome| {
+                    let s = &o.scores;
+                    let meets = s.mean_error_avg_pct <= 2.0
+                        && s.std_error_avg_pct <= 10.0
+                        && s.ks_max <= 0.08;
+                    (!meets, s.mean_error_avg_pct + s.std_error_avg_pct)
+                };
+                let (ka, kb) = (key(a), key(b));
+                ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
             })
             .map_or(0, |(i, _)| i);
         let dir = root.join(&self.report);

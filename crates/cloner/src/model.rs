@@ -6,7 +6,7 @@
 use levelset::Grid;
 use morph_dna::{
     AcceptanceRejection2d, BicubicPdf, Descriptor, DnaTable, GaussianCopula, Histogram1d,
-    Histogram2d, InverseCdfSampler1d, MeasureParams, PrincipalFrame, measure, principal_frame,
+    Histogram2d, InverseCdfSampler1d, MeasureParams, PrincipalFrame, measure_with_frame,
     radial_profile,
 };
 use rand::Rng;
@@ -89,8 +89,7 @@ impl Parents {
                     index,
                     reason: e.to_string(),
                 };
-                let dna = measure(g, &DNA, params).map_err(degenerate)?;
-                let frame = principal_frame(g).map_err(degenerate)?;
+                let (dna, frame) = measure_with_frame(g, &DNA, params).map_err(degenerate)?;
                 Ok((frame, dna))
             })
             .collect();
@@ -324,6 +323,9 @@ pub struct SteeringMap {
     pub shrink: [f64; 5],
     /// Pilot clones the map was fitted on (0: identity map).
     pub pilot_clones: usize,
+    /// Descriptors whose fit failed (slope not clearly positive) and which
+    /// keep the identity map.
+    pub unfitted: [bool; 5],
 }
 
 impl SteeringMap {
@@ -335,6 +337,7 @@ impl SteeringMap {
             parent_mean,
             shrink: [1.0; 5],
             pilot_clones: 0,
+            unfitted: [false; 5],
         }
     }
 
@@ -586,11 +589,10 @@ impl CloneModel {
             let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
             let slope = sxy / sxx;
             if !(slope.is_finite() && slope > 0.05) {
-                return Err(Error::InvalidParameter {
-                    name: "pilot_clones",
-                    value: n,
-                    reason: "pilot clones whose measured DNA rises with their surface DNA (fit failed)",
-                });
+                // the surface DNA does not predict the measured one: keep
+                // the identity for this descriptor and say so
+                map.unfitted[t] = true;
+                continue;
             }
             let offset = my - slope * mx;
             let ss: f64 = x
