@@ -379,6 +379,46 @@ fn second_order_distance(
     2.0 * v / (gp2.sqrt() + (gp2 - 2.0 * bv).sqrt())
 }
 
+/// The seed's interface estimate at a node with a neighbour of the other sign (`None`
+/// otherwise): `|g|/|∇g|` (central differences), capped by the distance to the nearest linear
+/// zero crossing along a grid edge, with the sign of `g` (see [`crate::reinit`]).
+fn interface_estimate([lo, mid, up]: [&[f64]; 3], c: usize, sy: usize, h: f64) -> Option<f64> {
+    let v = mid[c];
+    let inside = v < 0.0;
+    let nb = [
+        mid[c - 1],
+        mid[c + 1],
+        mid[c - sy],
+        mid[c + sy],
+        lo[c],
+        up[c],
+    ];
+    let mut cap = f64::INFINITY;
+    for w in nb {
+        if (w < 0.0) != inside {
+            // v and w differ in sign, so v − w ≠ 0 unless both are 0.
+            cap = cap.min(h * (v / (v - w)).abs());
+        }
+    }
+    if !cap.is_finite() {
+        return None;
+    }
+    let inv2h = 0.5 / h;
+    let (gx, gy, gz) = (
+        (nb[1] - nb[0]) * inv2h,
+        (nb[3] - nb[2]) * inv2h,
+        (nb[5] - nb[4]) * inv2h,
+    );
+    let gp = (gx * gx + gy * gy + gz * gz).sqrt();
+    // Far markers (±∞) in the stencil give a non-finite gradient: the cap alone.
+    let est = if gp.is_finite() && gp > 0.0 {
+        (v.abs() / gp).min(cap)
+    } else {
+        cap
+    };
+    Some(if inside { -est } else { est })
+}
+
 /// The narrow-band redistancing of [`Redistance::Band`]. `g` holds the radial signed
 /// distance at every node that can be within the band or its stencil, and ±∞ (sign only)
 /// elsewhere, and is overwritten with the result; `rmax` bounds the surface's distance from
@@ -462,22 +502,23 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
                     let v = mid[c];
                     // Cheap screen first: the first-order estimate |g|/|∇g| with |∇g| ≤ 2
                     // must be below 1.15 band widths (a node needing a larger second-order
-                    // correction takes the far field).
-                    if v * v >= 4.0 * cut2 {
-                        continue;
-                    }
-                    // The radial field is singular at the centre: the expansion is trusted
-                    // only where the node is farther from the centre than from the surface
-                    // along its ray (|g| ≤ ρ; this excludes band nodes deeper than r/2 in
-                    // grains thinner than 2·BAND_CELLS cells, which then take far-field
-                    // values).
+                    // correction takes the far field). The radial field is singular at the
+                    // centre: the expansion is trusted only where the node is farther from
+                    // the centre than from the surface along its ray (|g| ≤ ρ; this excludes
+                    // band nodes deeper than r/2 in grains thinner than 2·BAND_CELLS cells,
+                    // which then take far-field values).
                     let x = o.x + h * i as f64;
-                    if v * v > x * x + yz2 {
-                        continue;
-                    }
-                    let d = second_order_distance([&lo, &mid, up], c, sy, h, cut2);
+                    let d = if v * v >= 4.0 * cut2 || v * v > x * x + yz2 {
+                        f64::NAN
+                    } else {
+                        second_order_distance([&lo, &mid, up], c, sy, h, cut2)
+                    };
                     if d.abs() < band_w {
                         found.push((c, d));
+                    } else if let Some(e) = interface_estimate([&lo, &mid, up], c, sy, h) {
+                        // A node next to the surface where the expansion is not trusted:
+                        // the seed's first-order interface estimate.
+                        found.push((c, e));
                     }
                 }
             }
@@ -509,8 +550,9 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
                 if !band.has(c) || g[c] >= 0.0 {
                     continue;
                 }
+                // Nodes next to the surface stay (their far-field value would be poor).
                 let nb = [c - 1, c + 1, c - sy, c + sy, c - sz, c + sz];
-                if !nb.iter().all(|&q| band.has(q)) {
+                if !nb.iter().all(|&q| band.has(q) && g[q] < 0.0) {
                     continue;
                 }
                 let gx = g[c + 1] - g[c - 1];
@@ -760,7 +802,13 @@ impl Coarse {
                     // interpolated value of the other sign (next to the surface) is small, and
                     // only its magnitude is kept.
                     if !(in_band && (b - interp).abs() <= AGREEMENT * h) {
-                        g[c] = -interp.abs();
+                        // Off the band, `b` is still the radial distance |ρ − r(û)|: the
+                        // surface point on the node's ray is that far, so it bounds the
+                        // distance from above. The far field can exceed it where no source
+                        // is near (thin tips of rough grains, whose nodes leave the band):
+                        // clamp.
+                        let v = interp.abs();
+                        g[c] = -(if in_band { v } else { v.min(b.abs()) });
                     }
                 }
             }
