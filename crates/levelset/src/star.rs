@@ -910,6 +910,36 @@ mod tests {
     }
 
     #[test]
+    fn band_build_keeps_oblique_surfaces() {
+        // An ellipsoid seen from a centre near one tip: towards the far tip the surface is
+        // nearly parallel to the rays (|∇g| up to ≈ 4), where the band expansion is not
+        // trusted; the nodes next to the surface must still get interface estimates.
+        let a = Vector3::new(1.0, 0.5, 0.5);
+        let c = Point3::new(0.6, 0.0, 0.0);
+        let radius = |u: Unit<Vector3<f64>>| {
+            // Ray c + t·u against Σ (x/a)² = 1.
+            let (p, d) = (c.coords.component_div(&a), u.component_div(&a));
+            let (qa, qb, qc) = (d.dot(&d), 2.0 * p.dot(&d), p.dot(&p) - 1.0);
+            (-qb + (qb * qb - 4.0 * qa * qc).sqrt()) / (2.0 * qa)
+        };
+        let spec = GridSpec::cube(45, -1.2, 1.2).expect("spec");
+        let exact = 4.0 / 3.0 * std::f64::consts::PI * a.x * a.y * a.z;
+        let mut errors = Vec::new();
+        for redistance in [Redistance::Band, Redistance::FullSweep] {
+            let p = StarParams {
+                redistance,
+                ..StarParams::default()
+            };
+            let (g, _) = Grid::from_star(spec, &c, radius, &p).expect("build");
+            errors.push(g.volume() / exact - 1.0);
+        }
+        // Measured: band −0.57 %, full sweep −0.75 % (the cube map is coarse at the far tip,
+        // 1.6 from the centre).
+        assert!(errors[0].abs() < 0.007, "band volume {}", errors[0]);
+        assert!(errors[1].abs() < 0.009, "full-sweep volume {}", errors[1]);
+    }
+
+    #[test]
     fn band_build_keeps_the_interior_of_a_sphere() {
         let spec = GridSpec::cube(45, -1.2, 1.2).expect("spec");
         let (band, _) =
