@@ -546,7 +546,7 @@ fn write_plots(
         series: vec![curve(parents, "parents")?, curve(&b.dna, "clones")?],
     };
     std::fs::write(dir.join("grading.svg"), svg::render(&chart)).context("writing grading.svg")?;
-    let marker = |label: &str, f: fn(&Outcome) -> f64| svg::Series {
+    let marker = |label: &str, f: fn(&Outcome) -> f64, labelled: bool| svg::Series {
         label: label.into(),
         points: outcomes
             .iter()
@@ -558,7 +558,11 @@ fn write_plots(
             })
             .collect(),
         style: svg::Style::Markers,
-        point_labels: outcomes.iter().map(|o| o.config.name.clone()).collect(),
+        point_labels: if labelled {
+            outcomes.iter().map(|o| o.config.name.clone()).collect()
+        } else {
+            Vec::new()
+        },
     };
     let chart = svg::Chart {
         title: "Error against run time".into(),
@@ -566,8 +570,8 @@ fn write_plots(
         y_label: "average error (%)".into(),
         log_x: false,
         series: vec![
-            marker("mean error", |o| o.scores.mean_error_avg_pct),
-            marker("std error", |o| o.scores.std_error_avg_pct),
+            marker("mean error", |o| o.scores.mean_error_avg_pct, true),
+            marker("std error", |o| o.scores.std_error_avg_pct, false),
         ],
     };
     std::fs::write(dir.join("error_vs_time.svg"), svg::render(&chart))

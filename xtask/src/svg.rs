@@ -86,7 +86,8 @@ fn escape(s: &str) -> String {
 /// Renders `chart` as a standalone SVG document.
 pub(crate) fn render(chart: &Chart) -> String {
     let (w, h) = (640.0, 420.0);
-    let (ml, mr, mt, mb) = (70.0, 20.0, 40.0, 55.0);
+    let labelled = chart.series.iter().any(|s| !s.point_labels.is_empty());
+    let (ml, mr, mt, mb) = (70.0, if labelled { 150.0 } else { 20.0 }, 40.0, 55.0);
     let tx = |x: f64| {
         if chart.log_x {
             x.max(1e-300).log10()
@@ -227,7 +228,7 @@ pub(crate) fn render(chart: &Chart) -> String {
             }
         }
         let ly = mt + 16.0 + 16.0 * k as f64;
-        let lx = w - mr - 190.0;
+        let lx = w - mr - 120.0;
         let _ = writeln!(
             s,
             r#"<rect x="{lx}" y="{}" width="12" height="4" fill="{c}"/><text x="{}" y="{ly}">{}</text>"#,
