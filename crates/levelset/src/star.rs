@@ -533,8 +533,8 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
     // surface at convex kinks of r), the expansion can err without its guards noticing;
     // there the band values break |∇φ| = 1. An interior band node whose six neighbours are
     // band nodes and whose central-difference gradient norm is off by more than
-    // EIKONAL_SLACK leaves the band (one pass, on the values before the pass; it keeps its
-    // band value, whose sign is the radial one, for the far field to replace).
+    // EIKONAL_SLACK leaves the band (one pass, on the values before the pass) and takes the
+    // far field.
     let sz = plane;
     let mut demote = Vec::new();
     let (lo2, hi2) = (
@@ -567,6 +567,9 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
     }
     for c in demote {
         band.set(c, false);
+        // Its radial value is gone; −∞ (sign only, no bound) keeps the suspect band value
+        // from clamping the far field that replaces it.
+        g[c] = f64::NEG_INFINITY;
     }
     band
 }
