@@ -16,9 +16,11 @@
 //!   band is the distance to the closest points of the band, propagated on the 2h sub-grid of
 //!   even nodes by closest-point sweeps (the eight fast-sweeping orderings, seven upwind
 //!   neighbours) and interpolated trilinearly, so it stays a true distance deep inside
-//!   ([`Grid::inscribed_sphere`]). The exterior beyond the band holds the capped value
-//!   `max(ρ − r_max, min(|g|, BAND_CELLS·h))`: a lower bound of the distance, not a
-//!   distance (consumers outside a grain need only its sign: contact, meshing, volume).
+//!   ([`Grid::inscribed_sphere`]); it is capped by the radial distance `|g|`, an upper
+//!   bound. The exterior beyond the band holds the capped value `min(|g|, BAND_CELLS·h)`: a
+//!   lower bound of the distance, not a distance (consumers outside a grain need only its
+//!   sign: contact, meshing, volume; [`Grid::closest_point`] from a start point there finds
+//!   no gradient).
 //! * [`Redistance::FullSweep`] (the seed method): first-order estimates at the nodes next to
 //!   a sign change and fast-sweeping reinitialisation over the whole grid seeded with the
 //!   radial upper bounds ([`crate::reinit`]); first-order, so biased low in the interior of
@@ -49,14 +51,16 @@ pub enum DirectionTable {
 /// How the radial estimates of a star build become a signed-distance field.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Redistance {
-    /// Narrow band plus coarse far field (default, ≈ 4× faster than
-    /// [`Redistance::FullSweep`] on 45³). Nodes within [`BAND_CELLS`]·h of the surface get a
-    /// second-order closest-distance estimate from the radial distance (see the module docs);
-    /// every other node gets the fast-sweeping distance computed on the 2h sub-grid of even
-    /// nodes (seeded with the band values there) and interpolated trilinearly. Beyond the
-    /// band the values are therefore approximate distances, not bounds: first-order sweeping
-    /// on a 2h grid, measured within 0.5·h of the exact distance for the test ellipsoids
-    /// (interior and exterior, see the tests); signs are exact everywhere.
+    /// Narrow band (default, ≈ 3× faster than [`Redistance::FullSweep`] on 45³). Nodes within
+    /// [`BAND_CELLS`]·h of the surface get a second-order closest-distance estimate from the
+    /// radial distance (the seed's first-order interface estimate where the expansion is not
+    /// trusted next to the surface). Inside beyond the band: the distance to the closest
+    /// points of the band propagated on the 2h sub-grid of even nodes and interpolated
+    /// trilinearly, capped by the radial distance (an upper bound) — a distance, measured
+    /// within 0.4·h of the exact one for the test ellipsoids and exact at the centre of a
+    /// sphere ([`Grid::inscribed_sphere`]). Outside beyond the band: `min(|g|, BAND_CELLS·h)`,
+    /// a capped value that is a lower bound of the distance, not a distance. Signs are the
+    /// radial ones everywhere (exact for the tabulated surface).
     #[default]
     Band,
     /// The seed method: fixed first-order estimates at the nodes next to a sign change and
@@ -225,8 +229,6 @@ impl Grid {
         let mut values = Vec::with_capacity(spec.len());
         let h = spec.spacing;
         let calls;
-        // Largest radius of the (tabulated or called) surface.
-        let mut rmax_all = 0.0f64;
         match params.table {
             DirectionTable::CubeMap { face_cells } => {
                 let map = CubeMap::build(face_cells, &mut radius)?;
@@ -239,7 +241,6 @@ impl Grid {
                     .radii
                     .iter()
                     .fold((f64::INFINITY, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
-                rmax_all = rmax;
                 // The band build needs radii wherever a node or its stencil can be within
                 // BAND_CELLS·h of the surface.
                 let w = match params.redistance {
@@ -299,7 +300,6 @@ impl Grid {
                                     z: u.z,
                                 });
                             }
-                            rmax_all = rmax_all.max(r);
                             values.push(rho.max(0.0) - r);
                         }
                     }
@@ -311,7 +311,7 @@ impl Grid {
         // `Grid::new` re-checks that everything ended finite.
         match params.redistance {
             Redistance::FullSweep => redistance(&spec, &mut values, true)?,
-            Redistance::Band => band_redistance(&spec, centre, &mut values, rmax_all)?,
+            Redistance::Band => band_redistance(&spec, centre, &mut values)?,
         }
         Ok((
             Grid::new(spec, values)?,
@@ -421,15 +421,14 @@ fn interface_estimate([lo, mid, up]: [&[f64]; 3], c: usize, sy: usize, h: f64) -
 
 /// The narrow-band redistancing of [`Redistance::Band`]. `g` holds the radial signed
 /// distance at every node that can be within the band or its stencil, and ±∞ (sign only)
-/// elsewhere, and is overwritten with the result; `rmax` bounds the surface's distance from
-/// the centre.
-fn band_redistance(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64], rmax: f64) -> Result<()> {
+/// elsewhere, and is overwritten with the result.
+fn band_redistance(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Result<()> {
     if !crosses(spec, g) {
         return Err(Error::NoSurface);
     }
     let band = band_values(spec, centre, g);
-    let coarse = Coarse::interior(spec, centre, g, &band, rmax)?;
-    coarse.assemble(spec, centre, g, &band, rmax);
+    let coarse = Coarse::interior(spec, g, &band)?;
+    coarse.assemble(spec, g, &band);
     Ok(())
 }
 
@@ -574,13 +573,14 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
     band
 }
 
-/// Value of an exterior node outside the band: `max(ρ − r_max, min(|g|, BAND_CELLS·h))`.
-/// `ρ − r_max` is a lower bound of the distance (the surface lies in the ball `r_max`);
-/// the band width is one wherever the band estimate was trusted; `|g|` (an upper bound)
-/// keeps nodes next to the surface that the band left out close to the surface.
+/// Value of an exterior node outside the band: `min(|g|, BAND_CELLS·h)`, the band width
+/// capped by the radial distance. The band width is a lower bound of the distance wherever
+/// the band estimate was trusted (and always outside the radial shell, which is wider than
+/// the band); `|g|` (an upper bound) keeps nodes next to the surface that the band left out
+/// close to the surface.
 #[inline]
-fn exterior_value(rho: f64, g: f64, rmax: f64, band_w: f64) -> f64 {
-    (rho - rmax).max(g.abs().min(band_w))
+fn exterior_value(g: f64, band_w: f64) -> f64 {
+    g.abs().min(band_w)
 }
 
 /// Interior far field on the coarse grid of the even nodes (spacing 2h; one node beyond the
@@ -597,13 +597,7 @@ impl Coarse {
     /// closest surface point is `x − d·∇g/|∇g|`, to every interior coarse node; exterior
     /// coarse nodes outside the band take [`exterior_value`].
     #[inline(never)]
-    fn interior(
-        spec: &GridSpec,
-        centre: &Point3<f64>,
-        g: &[f64],
-        band: &Band,
-        rmax: f64,
-    ) -> Result<Self> {
+    fn interior(spec: &GridSpec, g: &[f64], band: &Band) -> Result<Self> {
         let [nx, ny, nz] = spec.dims;
         let h = spec.spacing;
         let (sy, sz) = (nx, nx * ny);
@@ -627,7 +621,6 @@ impl Coarse {
         let mut any_source = false;
         let inv2h = 0.5 / h;
         let band_w = BAND_CELLS * h;
-        let oc = spec.origin.coords - centre.coords;
         for kc in 0..m[2] {
             for jc in 0..m[1] {
                 for ic in 0..m[0] {
@@ -664,8 +657,7 @@ impl Coarse {
                         r.0 = r.0.min(ic);
                         r.1 = r.1.max(ic + 1);
                     } else {
-                        let x = oc + 2.0 * h * Vector3::new(i as f64, j as f64, k as f64);
-                        dist[p] = exterior_value(x.norm(), g[c], rmax, band_w);
+                        dist[p] = exterior_value(g[c], band_w);
                     }
                 }
             }
@@ -733,14 +725,7 @@ impl Coarse {
     /// interpolation of the coarse values (separably: x, then y, then z); elsewhere outside,
     /// [`exterior_value`].
     #[inline(never)]
-    fn assemble(
-        &self,
-        spec: &GridSpec,
-        centre: &Point3<f64>,
-        g: &mut [f64],
-        band: &Band,
-        rmax: f64,
-    ) {
+    fn assemble(&self, spec: &GridSpec, g: &mut [f64], band: &Band) {
         let [nx, ny, nz] = spec.dims;
         let h = spec.spacing;
         let (sy, sz) = (nx, nx * ny);
@@ -764,13 +749,8 @@ impl Coarse {
             }
         }
         let band_w = BAND_CELLS * h;
-        let reach2 = (rmax + band_w) * (rmax + band_w);
-        let o = spec.origin.coords - centre.coords;
         for k in 0..nz {
-            let z = o.z + h * k as f64;
             for j in 0..ny {
-                let y = o.y + h * j as f64;
-                let yz2 = y * y + z * z;
                 let dst = sy * j + sz * k;
                 // The (up to four) coarse rows around the fine row and their weights.
                 let (j0, j1) = (j / 2, j.div_ceil(2));
@@ -792,11 +772,7 @@ impl Coarse {
                         continue;
                     }
                     if !inside {
-                        let x = o.x + h * i as f64;
-                        let rho2 = x * x + yz2;
-                        // ρ − r_max only matters beyond r_max + band width (no root before).
-                        let rho = if rho2 > reach2 { rho2.sqrt() } else { 0.0 };
-                        g[c] = exterior_value(rho, g[c], rmax, band_w);
+                        g[c] = exterior_value(g[c], band_w);
                         continue;
                     }
                     let interp = 0.25 * (ax[r[0] + i] + ax[r[1] + i] + ax[r[2] + i] + ax[r[3] + i]);
