@@ -486,6 +486,8 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
     let mut lo = g[..plane].to_vec();
     let mut mid = vec![0.0; plane];
     let mut found = Vec::new();
+    // The interior band nodes, for the consistency check.
+    let mut inner = Vec::new();
     for k in 1..nz - 1 {
         mid.copy_from_slice(&g[plane * k..plane * (k + 1)]);
         found.clear();
@@ -514,7 +516,11 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
                     };
                     if d.abs() < band_w {
                         found.push((c, d));
-                    } else if let Some(e) = interface_estimate([&lo, &mid, up], c, sy, h) {
+                    } else if let Some(e) = v
+                        .is_finite()
+                        .then(|| interface_estimate([&lo, &mid, up], c, sy, h))
+                        .flatten()
+                    {
                         // A node next to the surface where the expansion is not trusted:
                         // the seed's first-order interface estimate.
                         found.push((c, e));
@@ -525,6 +531,9 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
         for &(c, d) in &found {
             g[plane * k + c] = d;
             band.set(plane * k + c, true);
+            if d < 0.0 {
+                inner.push(plane * k + c);
+            }
         }
         std::mem::swap(&mut lo, &mut mid);
     }
@@ -540,28 +549,20 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64]) -> Band {
         (1.0 - EIKONAL_SLACK).powi(2) * 4.0 * h * h,
         (1.0 + EIKONAL_SLACK).powi(2) * 4.0 * h * h,
     );
-    for k in 1..nz - 1 {
-        for j in 1..ny - 1 {
-            let row = sy * j + sz * k;
-            for i in 1..nx - 1 {
-                let c = row + i;
-                // Outside, the far field is only a bound: exterior band values are kept.
-                if !band.has(c) || g[c] >= 0.0 {
-                    continue;
-                }
-                // Nodes next to the surface stay (their far-field value would be poor).
-                let nb = [c - 1, c + 1, c - sy, c + sy, c - sz, c + sz];
-                if !nb.iter().all(|&q| band.has(q) && g[q] < 0.0) {
-                    continue;
-                }
-                let gx = g[c + 1] - g[c - 1];
-                let gy = g[c + sy] - g[c - sy];
-                let gz = g[c + sz] - g[c - sz];
-                let n2 = gx * gx + gy * gy + gz * gz;
-                if n2 > hi2 || n2 < lo2 {
-                    demote.push(c);
-                }
-            }
+    // Outside, the far field is only a bound: exterior band values are kept. Band nodes are
+    // interior grid nodes, so their six neighbours exist.
+    for &c in &inner {
+        // Nodes next to the surface stay (their far-field value would be poor).
+        let nb = [c - 1, c + 1, c - sy, c + sy, c - sz, c + sz];
+        if !nb.iter().all(|&q| band.has(q) && g[q] < 0.0) {
+            continue;
+        }
+        let gx = g[c + 1] - g[c - 1];
+        let gy = g[c + sy] - g[c - sy];
+        let gz = g[c + sz] - g[c - sz];
+        let n2 = gx * gx + gy * gy + gz * gz;
+        if n2 > hi2 || n2 < lo2 {
+            demote.push(c);
         }
     }
     for c in demote {
