@@ -41,7 +41,7 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use levelset::{Grid, GridSpec, StarParams};
-use morph_dna::{DnaTable, MeasureParams, measure};
+use morph_dna::{Descriptor, DnaTable, MeasureParams, measure};
 use nalgebra::Point3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -627,16 +627,26 @@ impl CloneModel {
                     continue;
                 };
                 if measure_dna {
-                    let d = measure(&g, &DNA, &MeasureParams::default());
-                    stats.times.measure_ns += clock.now_ns() - t1;
-                    match d {
-                        Ok(d) => {
-                            if let Some(t) = check_roundness
-                                && (d[2] - cand.targets.roundness).abs() > t
-                            {
+                    // the roundness check first, on roundness alone (morph-dna
+                    // computes each descriptor identically alone or in a set),
+                    // so a rejected clone does not pay for the volume pass
+                    let mp = MeasureParams::default();
+                    let d = match check_roundness {
+                        Some(t) => match measure(&g, &[Descriptor::Roundness], &mp) {
+                            Ok(r) if (r[0] - cand.targets.roundness).abs() > t => {
+                                stats.times.measure_ns += clock.now_ns() - t1;
                                 stats.rejections.measured_roundness += 1;
                                 continue;
                             }
+                            Ok(_) if !outputs.dna => Ok(Vec::new()),
+                            Ok(_) => measure(&g, &DNA, &mp),
+                            Err(e) => Err(e),
+                        },
+                        None => measure(&g, &DNA, &mp),
+                    };
+                    stats.times.measure_ns += clock.now_ns() - t1;
+                    match d {
+                        Ok(d) => {
                             if outputs.dna {
                                 dna = Some(d);
                             }
