@@ -194,7 +194,16 @@ fn load_parents() -> anyhow::Result<(Parents, Vec<String>)> {
 
 fn progress_bar(label: &str) -> impl Fn(Progress) + Sync + '_ {
     let last = Mutex::new(0u64);
+    // a bar on a terminal; quarter-way lines in a log
+    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
     move |p: Progress| {
+        if !tty {
+            let q = (p.total / 4).max(1);
+            if p.done % q == 0 || p.done == p.total {
+                eprintln!("  {label:<32} {}/{}", p.done, p.total);
+            }
+            return;
+        }
         let step = (p.total / 50).max(1);
         let mut l = last
             .lock()

@@ -217,6 +217,9 @@ impl RunStats {
     }
 }
 
+/// [`DNA`] without the roundness (index 2), in order.
+const DNA_BUT_ROUNDNESS: [Descriptor; 5] = [DNA[0], DNA[1], DNA[3], DNA[4], DNA[5]];
+
 /// One accepted clone.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ClonedGrain {
@@ -639,7 +642,12 @@ impl CloneModel {
                                 continue;
                             }
                             Ok(_) if !outputs.dna => Ok(Vec::new()),
-                            Ok(_) => measure(&g, &DNA, &mp),
+                            // the other five, with the roundness already known
+                            Ok(r) => measure(&g, &DNA_BUT_ROUNDNESS, &mp).map(|v| {
+                                let mut d = v;
+                                d.insert(2, r[0]);
+                                d
+                            }),
                             Err(e) => Err(e),
                         },
                         None => measure(&g, &DNA, &mp),
