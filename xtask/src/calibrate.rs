@@ -199,7 +199,7 @@ fn progress_bar(label: &str) -> impl Fn(Progress) + Sync + '_ {
     move |p: Progress| {
         if !tty {
             let q = (p.total / 4).max(1);
-            if p.done % q == 0 || p.done == p.total {
+            if p.done.is_multiple_of(q) || p.done == p.total {
                 eprintln!("  {label:<32} {}/{}", p.done, p.total);
             }
             return;
