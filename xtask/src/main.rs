@@ -1,10 +1,13 @@
 //! grainforge's task runner: the project's only binary.
 //!
-//! `cargo xtask validate [--filter PATTERN] [--report DIR] [--fast]` runs the
-//! reference cases of the `validate` crate, prints the result table and exits
-//! non-zero on failure. `cargo xtask calibrate` (the cloner sweep) lands with
-//! the `cloner` crate. The tidy checks of the workspace are `#[test]`s in
-//! `tidy.rs`, run by `cargo test`.
+//! `cargo xtask calibrate` (the main job) sweeps the cloner over the seed's
+//! trial grid and writes the calibration report and fixture; `cargo xtask
+//! clone` writes clones with the calibrated configuration; `cargo xtask
+//! validate [--filter PATTERN] [--report DIR] [--fast]` runs the reference
+//! cases of the `validate` crate, prints the result table and exits non-zero
+//! on failure; `cargo xtask dna` and `convergence` write generated tables.
+//! The tidy checks of the workspace are `#[test]`s in `tidy.rs`, run by
+//! `cargo test`.
 //!
 //! Heavy science stays in the libraries and is called in-process; this crate
 //! only knows paths, parses flags and prints.
@@ -15,6 +18,7 @@
 use clap::{Parser, Subcommand};
 
 mod calibrate;
+mod clone_cmd;
 mod convergence;
 mod dna;
 mod svg;
@@ -37,6 +41,9 @@ enum Command {
     /// Ottawa-sand parents and write the calibration report
     /// (`--check` re-scores the committed calibration).
     Calibrate(calibrate::Calibrate),
+    /// Generate clones with the calibrated configuration and write them
+    /// (LS-DEM morph files, optional VTK/STL, DNA tables).
+    Clone(clone_cmd::Clone),
     /// Run the reference validation cases and print the result table.
     Validate(validate_cmd::Validate),
     /// Measure the morphological DNA of every shipped real grain into
@@ -61,6 +68,7 @@ fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Calibrate(cmd) => cmd.run(&workspace_root()),
+        Command::Clone(cmd) => cmd.run(&workspace_root()),
         Command::Validate(cmd) => cmd.run(),
         Command::Dna(cmd) => cmd.run(&workspace_root()),
         Command::Convergence(cmd) => cmd.run(&workspace_root()),
