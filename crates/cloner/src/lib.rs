@@ -27,11 +27,20 @@
 //!   comes from the flatness `S / I`, drawn with the other targets.
 //! * **Steering measure.** Polishing and the quality control compare the
 //!   candidate's *surface DNA* (computed from its node radii in
-//!   microseconds) with targets drawn from the parents' surface DNA computed
-//!   by the same code, so steering is self-consistent and no level set is
-//!   built for a rejected candidate. Accepted clones are then measured on
-//!   their level sets exactly like the parents (`morph_dna::measure`), and
-//!   that is what calibration compares.
+//!   microseconds) with its targets, so no level set is built for a rejected
+//!   candidate. Targets are drawn from the parents' DNA *measured on their
+//!   level sets* and mapped into surface measure by a [`SteeringMap`] fitted
+//!   on pilot clones (`Params::pilot_clones`; the map's pull towards the mean
+//!   keeps the surface-to-level-set scatter from widening the clones'
+//!   distributions). Accepted clones are measured on their level sets exactly
+//!   like the parents (`morph_dna::measure`), and that is what calibration
+//!   compares.
+//! * **Rejection without tilt.** The targets are held for up to
+//!   `Params::fields_per_target` radii fields, so the quality control does
+//!   not favour easy targets; a candidate rounder than its target is sharpened
+//!   (inverse Laplacian steps) instead of rejected; an optional level-set
+//!   roundness check (`Params::roundness_tolerance`) removes the residual
+//!   scatter of the surface roundness.
 //! * **Seed methods kept.** [`Params::seed_faithful`] selects the seed's
 //!   pairwise-PDF targets, neighbourhood-averaged radii, bilinear
 //!   interpolation and untouched embryo axes, for comparison.
