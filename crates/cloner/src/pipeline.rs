@@ -389,10 +389,12 @@ impl CloneModel {
         polished?;
         // axis correction and quality control
         let result = (|| {
+            // the quality control needs no curvature: moments and area only,
+            // the full surface DNA once for an accepted candidate
             self.radii_from(&s.r_ell, &s.rho, &mut s.r);
             let mut surf = self
                 .geom
-                .surface_dna(&s.r, res, margin)
+                .surface_dna_with(&s.r, res, margin, false)
                 .ok_or(Reject::Degenerate)?;
             // early rejection on the scale-free ratio (V/S)/S, which the axis
             // corrections barely change: 3× the tolerance
@@ -412,7 +414,7 @@ impl CloneModel {
                 self.radii_from(&s.r_ell, &s.rho, &mut s.r);
                 surf = self
                     .geom
-                    .surface_dna(&s.r, res, margin)
+                    .surface_dna_with(&s.r, res, margin, false)
                     .ok_or(Reject::Degenerate)?;
             }
             let vs = surf.volume_surface_ratio();
@@ -420,6 +422,10 @@ impl CloneModel {
             if (vs - want).abs() > p.tolerance * want {
                 return Err(Reject::QualityControl);
             }
+            let surf = self
+                .geom
+                .surface_dna(&s.r, res, margin)
+                .ok_or(Reject::Degenerate)?;
             Ok(Candidate {
                 radii: s.r.clone(),
                 targets: goal_targets,

@@ -280,6 +280,16 @@ impl MeshGeometry {
         (dens, if k1.is_finite() { k1 } else { 0.0 })
     }
 
+    /// Area element factor at ring node `f` (the first derivatives only; the
+    /// same value as [`MeshGeometry::ring_geometry`]'s).
+    fn ring_density(&self, r: &[f64], f: usize) -> f64 {
+        let nb = self.nbrs[f];
+        let rt = (r[nb[2]] - r[nb[3]]) / (2.0 * self.dtheta);
+        let rp = (r[nb[0]] - r[nb[1]]) / (2.0 * self.dphi);
+        let rr = r[f];
+        rr * (rr * rr + rt * rt + rp * rp * self.frames[f].1).sqrt()
+    }
+
     /// Area element factor at a pole (slope from the adjacent ring).
     fn pole_density(&self, r: &[f64], pole: usize) -> f64 {
         let (n_az, n_pol) = (self.mesh.n_az, self.mesh.n_pol);
@@ -321,6 +331,19 @@ impl MeshGeometry {
     /// The full surface DNA, `None` for a degenerate field (non-positive or
     /// non-finite radii, or moments of a flat body).
     pub fn surface_dna(&self, r: &[f64], resolution: usize, margin: f64) -> Option<SurfaceDna> {
+        self.surface_dna_with(r, resolution, margin, true)
+    }
+
+    /// As [`MeshGeometry::surface_dna`]; without `roundness` the curvatures
+    /// are skipped (the cost of most of it) and the roundness reads NaN.
+    pub(crate) fn surface_dna_with(
+        &self,
+        r: &[f64],
+        resolution: usize,
+        margin: f64,
+        roundness: bool,
+    ) -> Option<SurfaceDna> {
+        let with_roundness = roundness;
         if r.len() != self.n_nodes() || r.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
             return None;
         }
@@ -342,16 +365,20 @@ impl MeshGeometry {
             second += (u * u.transpose()) * (w * r3 * rr * rr / 5.0);
             if f == 0 || f == n - 1 {
                 area += w * self.pole_density(r, f);
-            } else {
+            } else if with_roundness {
                 let (dens, k1) = self.ring_geometry(r, f);
                 area += w * dens;
                 if k1 > threshold {
                     sw += w * dens;
                     swk += w * dens * k1.min(cap);
                 }
+            } else {
+                area += w * self.ring_density(r, f);
             }
         }
-        let roundness = if sw == 0.0 || swk == 0.0 {
+        let roundness = if !with_roundness {
+            f64::NAN
+        } else if sw == 0.0 || swk == 0.0 {
             1.0
         } else {
             ((sw / swk) / r_min).min(1.0)

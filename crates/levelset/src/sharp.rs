@@ -36,7 +36,14 @@ use crate::surface::Sink;
 const UNIT_TOL: f64 = 0.02;
 
 /// Smallest `| |∇φ| − 1 |` of a central-difference gradient that flags its cells.
-const FLAG_TOL: f64 = 0.05;
+///
+/// A kink flags its cells clearly: across a 90° convex edge the central difference has norm
+/// ≈ 0.71. A smooth surface does not need the correction, but the central differences of a
+/// band-built field (`Redistance::Band`) on curved surfaces deviate by up to ≈ 0.19. At 0.05
+/// those cells were flagged too: on a 45³ cloned grain 3.4 ms instead of 0.85 ms for a volume
+/// change of 1e-5. At 0.2 the box and cylinder cases are unchanged (box 2 × 1 × 0.5 on 45³:
+/// −0.041 %).
+const FLAG_TOL: f64 = 0.2;
 
 /// A convex polyhedron as outward-oriented faces (counter-clockwise seen from outside),
 /// face `f` being `pts[ends[f − 1]..ends[f]]`.

@@ -153,3 +153,19 @@ fn needle_and_flat_ellipsoids_stay_finite() {
         }
     }
 }
+
+#[test]
+fn the_moments_only_path_equals_the_full_one() {
+    let g = geom(28, 18);
+    let r: Vec<f64> = (0..g.n_nodes())
+        .map(|k| {
+            g.ellipsoid_radius(k, [1.4, 1.0, 0.7]) * (1.0 + 0.03 * ((k * 7) % 11) as f64 / 11.0)
+        })
+        .collect();
+    let full = g.surface_dna(&r, 45, 1.1).expect("valid");
+    let fast = g.surface_dna_with(&r, 45, 1.1, false).expect("valid");
+    assert_eq!(full.volume.to_bits(), fast.volume.to_bits());
+    assert_eq!(full.area.to_bits(), fast.area.to_bits());
+    assert_eq!(full.dims, fast.dims);
+    assert!(fast.roundness.is_nan() && full.roundness > 0.0);
+}
