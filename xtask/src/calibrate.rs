@@ -32,8 +32,7 @@ use clap::Args;
 use cloner::{
     Calibrated, CloneModel, Hooks, Params, Parents, Progress, RunStats, Scores, TABLES_4_5, score,
 };
-use levelset::Grid;
-use morph_dna::{Descriptor, DnaTable, GradingCurve, GradingWeight, MeasureParams, SphericalMesh};
+use morph_dna::{Descriptor, DnaTable, GradingCurve, GradingWeight, SphericalMesh};
 
 use crate::svg;
 
@@ -177,19 +176,6 @@ fn sweep(seed: u64) -> Vec<Config> {
         },
     });
     out
-}
-
-fn load_parents() -> anyhow::Result<(Parents, Vec<String>)> {
-    let models = validate::grains::ottawa_models()?;
-    let names: Vec<String> = models.iter().map(|(n, _, _)| n.clone()).collect();
-    let grids: Vec<Grid> = models
-        .iter()
-        .map(|(n, m, _)| cloner::grid_from_sh(m, 45, 1.1).with_context(|| format!("grain {n}")))
-        .collect::<anyhow::Result<_>>()?;
-    Ok((
-        Parents::from_grids(grids, &MeasureParams::default())?,
-        names,
-    ))
 }
 
 fn progress_bar(label: &str) -> impl Fn(Progress) + Sync + '_ {
@@ -592,7 +578,7 @@ impl Calibrate {
     pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
         let start = Instant::now();
         eprintln!("preparing the Ottawa-sand parents (45³ level sets, DNA)…");
-        let (parents, _names) = load_parents()?;
+        let parents = validate::grains::ottawa_parents()?;
         let prep_s = start.elapsed().as_secs_f64();
         eprintln!("{} parents in {prep_s:.1} s", parents.len());
         if self.check {

@@ -10,8 +10,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use cloner::{Calibrated, CloneModel, Format, Hooks, Outputs, Parents, shard_range, write_grid};
-use morph_dna::MeasureParams;
+use cloner::{Calibrated, CloneModel, Format, Hooks, Outputs, shard_range, write_grid};
 
 /// Flags of `cargo xtask clone`.
 #[derive(Debug, Args)]
@@ -75,11 +74,7 @@ impl Clone {
             params.seed = s;
         }
         eprintln!("preparing the Ottawa-sand parents…");
-        let grids = validate::grains::ottawa_models()?
-            .iter()
-            .map(|(n, m, _)| cloner::grid_from_sh(m, 45, 1.1).with_context(|| format!("grain {n}")))
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        let parents = Parents::from_grids(grids, &MeasureParams::default())?;
+        let parents = validate::grains::ottawa_parents()?;
         let model = CloneModel::fit(&parents, &params)?;
         let run = model.run(range.clone(), Hooks::default())?;
         let dir = root.join(&self.out);

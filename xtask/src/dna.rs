@@ -15,11 +15,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use clap::Args;
-use levelset::GridSpec;
-use levelset::nalgebra::Point3;
-use morph_dna::{
-    CorrelationMethod, Descriptor, DnaTable, MeasureParams, correlation_matrix, measure_star,
-};
+use morph_dna::{CorrelationMethod, Descriptor, DnaTable, MeasureParams, correlation_matrix};
 use sph_harmonics::ShModel;
 
 /// Flags of `cargo xtask dna`.
@@ -107,26 +103,10 @@ fn geom_table() -> anyhow::Result<Vec<(String, Geom)>> {
 }
 
 fn measure_grain(model: &ShModel, resolution: usize) -> anyhow::Result<Vec<f64>> {
-    // bounding radius from a dense direction sample, with a 10 % margin
-    let mut dirs = Vec::new();
-    for i in 0..=64 {
-        for j in 0..128 {
-            dirs.push((
-                std::f64::consts::PI * i as f64 / 64.0,
-                std::f64::consts::TAU * j as f64 / 128.0,
-            ));
-        }
-    }
-    let r_max = model.evaluate(&dirs)?.into_iter().fold(0.0f64, f64::max);
-    let spec = GridSpec::cube(resolution, -1.1 * r_max, 1.1 * r_max)?;
-    let radius = |u: levelset::nalgebra::Unit<levelset::nalgebra::Vector3<f64>>| {
-        let (theta, phi) = sph_harmonics::model::to_angles(&u.into_inner());
-        model.radius(theta, phi).unwrap_or(f64::NAN)
-    };
-    Ok(measure_star(
-        spec,
-        &Point3::origin(),
-        radius,
+    // the bounding cube ×1.1 of the grain (shared with the cloner's parents)
+    let grid = cloner::grid_from_sh(model, resolution, 1.1)?;
+    Ok(morph_dna::measure(
+        &grid,
         &Descriptor::ALL,
         &MeasureParams::default(),
     )?)

@@ -63,3 +63,23 @@ pub fn ottawa_models() -> Result<Vec<(String, ShModel, usize)>, Error> {
     }
     Ok(out)
 }
+
+/// The shipped Ottawa grains as cloner parents: 45³ level sets over each
+/// grain's bounding cube ×1.1 (`cloner::grid_from_sh`, the construction of
+/// `cargo xtask dna`), measured with the default `morph_dna::MeasureParams`.
+/// Shared by `cargo xtask calibrate`, `cargo xtask clone` and the cloner
+/// validation case.
+///
+/// # Errors
+/// Those of [`ottawa_models`], and [`Error::Computation`] for a grain that
+/// cannot be rasterised or measured.
+pub fn ottawa_parents() -> Result<cloner::Parents, Error> {
+    let err = |e: cloner::Error| Error::Computation {
+        message: e.to_string(),
+    };
+    let grids = ottawa_models()?
+        .iter()
+        .map(|(_, m, _)| cloner::grid_from_sh(m, 45, 1.1).map_err(err))
+        .collect::<Result<Vec<_>, _>>()?;
+    cloner::Parents::from_grids(grids, &morph_dna::MeasureParams::default()).map_err(err)
+}

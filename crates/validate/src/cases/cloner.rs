@@ -5,8 +5,7 @@
 //! error ≤ 2 %, average standard-deviation error ≤ 10 %, every KS ≤ 0.08).
 //! The run is deterministic, so it must also reproduce the committed scores.
 
-use cloner::{Calibrated, CloneModel, Hooks, Parents, TABLES_4_5, grid_from_sh, score};
-use morph_dna::MeasureParams;
+use cloner::{Calibrated, CloneModel, Hooks, TABLES_4_5, score};
 
 use crate::fixtures::{self, Table};
 use crate::{Case, Check, Error, ExpectedFailure, Tolerance};
@@ -39,11 +38,7 @@ fn calibrated() -> Result<Vec<Check>, Error> {
             name: format!("calibrated/{CALIBRATED}"),
         })?;
     let cal = Calibrated::from_ron(text).map_err(err)?;
-    let grids = crate::grains::ottawa_models()?
-        .iter()
-        .map(|(_, m, _)| grid_from_sh(m, 45, 1.1).map_err(err))
-        .collect::<Result<Vec<_>, _>>()?;
-    let parents = Parents::from_grids(grids, &MeasureParams::default()).map_err(err)?;
+    let parents = crate::grains::ottawa_parents()?;
     let model = CloneModel::fit(&parents, &cal.params).map_err(err)?;
     let run = model.run(0..cal.clones, Hooks::default()).map_err(err)?;
     let s = score(parents.dna(), &run.dna_table().map_err(err)?).map_err(err)?;
