@@ -25,6 +25,14 @@ fn benches(c: &mut Criterion) {
             Grid::from_star(spec, &Point3::origin(), lumpy, &StarParams::default()).expect("build")
         })
     });
+    // The per-node passes split over z-slabs on the rayon pool (bit-identical result).
+    let par = StarParams {
+        parallel: true,
+        ..StarParams::default()
+    };
+    c.bench_function("star_build_45_parallel", |b| {
+        b.iter(|| Grid::from_star(spec, &Point3::origin(), lumpy, &par).expect("build"))
+    });
     // The seed method, for comparison.
     let full = StarParams {
         redistance: Redistance::FullSweep,
