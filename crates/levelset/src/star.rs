@@ -100,6 +100,9 @@ pub struct StarParams {
     /// over z-slabs on the rayon pool (default `false`: callers that build many grids, like
     /// the cloner, parallelise over grids instead). The radius function is still called on
     /// the calling thread, and the result is bit-identical to the sequential build.
+    /// Measured on a 2-vCPU machine: 0–25 % faster on 45³ (the sequential parts, the
+    /// radius calls among them, are ≈ 30 % of the build, and the pool wakes three times per
+    /// build); more cores and larger grids gain more.
     pub parallel: bool,
 }
 
