@@ -286,8 +286,8 @@ impl Grid {
                 let inner2 = inner * inner;
                 let outer2 = (rmax + w) * (rmax + w);
                 let o = spec.origin - centre;
-                // Per column: x, x² and 1/|x| (the per-node division of the face
-                // coordinates becomes a table lookup).
+                // Per column: x and 1/|x| (the per-node division of the face coordinates
+                // becomes a table lookup).
                 let xs: Vec<f64> = (0..nx).map(|i| o.x + h * i as f64).collect();
                 let inv_x: Vec<f64> = xs.iter().map(|x| 1.0 / x.abs()).collect();
                 values.resize(spec.len(), FAR);
@@ -316,17 +316,7 @@ impl Grid {
                         }
                     }
                 };
-                let plane = nx * ny;
-                if params.parallel {
-                    values
-                        .par_chunks_mut(plane)
-                        .enumerate()
-                        .for_each(|(k, slab)| fill(k, slab));
-                } else {
-                    for (k, slab) in values.chunks_mut(plane).enumerate() {
-                        fill(k, slab);
-                    }
-                }
+                for_each_slab(&mut values, nx * ny, params.parallel, fill);
             }
             DirectionTable::Exact => {
                 let mut count = 0usize;
@@ -369,6 +359,26 @@ impl Grid {
                 radius_calls: calls,
             },
         ))
+    }
+}
+
+/// Runs `f(k, slab)` on every z-slab (`plane` values) of `values`, on the rayon pool if
+/// `parallel`.
+fn for_each_slab(
+    values: &mut [f64],
+    plane: usize,
+    parallel: bool,
+    f: impl Fn(usize, &mut [f64]) + Sync,
+) {
+    if parallel {
+        values
+            .par_chunks_mut(plane)
+            .enumerate()
+            .for_each(|(k, slab)| f(k, slab));
+    } else {
+        for (k, slab) in values.chunks_mut(plane).enumerate() {
+            f(k, slab);
+        }
     }
 }
 
@@ -876,15 +886,7 @@ impl Coarse {
                 }
             }
         };
-        if parallel {
-            g.par_chunks_mut(sz)
-                .enumerate()
-                .for_each(|(k, slab)| fill(k, slab));
-        } else {
-            for (k, slab) in g.chunks_mut(sz).enumerate() {
-                fill(k, slab);
-            }
-        }
+        for_each_slab(g, sz, parallel, fill);
     }
 }
 
