@@ -25,13 +25,13 @@ fn benches(c: &mut Criterion) {
             Grid::from_star(spec, &Point3::origin(), lumpy, &StarParams::default()).expect("build")
         })
     });
-    // The per-node passes split over z-slabs on the rayon pool (bit-identical result).
+    // Radius calls and per-node passes on the rayon pool (bit-identical result).
     let par = StarParams {
         parallel: true,
         ..StarParams::default()
     };
     c.bench_function("star_build_45_parallel", |b| {
-        b.iter(|| Grid::from_star(spec, &Point3::origin(), lumpy, &par).expect("build"))
+        b.iter(|| Grid::from_star_sync(spec, &Point3::origin(), lumpy, &par).expect("build"))
     });
     // The seed method, for comparison.
     let full = StarParams {

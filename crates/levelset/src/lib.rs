@@ -66,6 +66,7 @@
 //! Layer 0: no internal dependencies (see `docs/architecture.md`).
 
 pub mod contact;
+mod crew;
 pub mod error;
 pub mod grid;
 pub mod io;

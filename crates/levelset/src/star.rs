@@ -38,10 +38,12 @@
 
 use nalgebra::{Point3, Unit, Vector3};
 
+use crate::crew;
 use crate::error::{Error, Result};
 use crate::grid::{Grid, GridSpec};
 use crate::reinit::redistance;
 use rayon::prelude::*;
+use std::sync::{Mutex, OnceLock};
 
 /// How the radius function is sampled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -156,31 +158,59 @@ struct CubeMap {
 const OTHER: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
 
 impl CubeMap {
+    /// Direction of node (p, q) of face f (not normalised).
+    #[inline]
+    fn direction(n: usize, f: usize, p: usize, q: usize) -> Unit<Vector3<f64>> {
+        let axis = f / 2;
+        let [b, c] = OTHER[axis];
+        let mut d = Vector3::zeros();
+        d[axis] = if f.is_multiple_of(2) { 1.0 } else { -1.0 };
+        d[b] = -1.0 + 2.0 * p as f64 / n as f64;
+        d[c] = -1.0 + 2.0 * q as f64 / n as f64;
+        Unit::new_normalize(d)
+    }
+
     fn build(n: usize, r: &mut impl FnMut(Unit<Vector3<f64>>) -> f64) -> Result<Self> {
         let m = n + 1;
         let mut radii = Vec::with_capacity(6 * m * m);
         for f in 0..6 {
-            let axis = f / 2;
-            let s = if f % 2 == 0 { 1.0 } else { -1.0 };
-            let [b, c] = OTHER[axis];
             for q in 0..m {
                 for p in 0..m {
-                    let mut d = Vector3::zeros();
-                    d[axis] = s;
-                    d[b] = -1.0 + 2.0 * p as f64 / n as f64;
-                    d[c] = -1.0 + 2.0 * q as f64 / n as f64;
-                    let u = Unit::new_normalize(d);
-                    let v = r(u);
-                    if !(v.is_finite() && v > 0.0) {
-                        return Err(Error::InvalidRadius {
-                            value: v,
-                            x: u.x,
-                            y: u.y,
-                            z: u.z,
-                        });
-                    }
-                    radii.push(v as f32);
+                    let u = Self::direction(n, f, p, q);
+                    radii.push(checked_radius(u, r(u))? as f32);
                 }
+            }
+        }
+        Ok(Self { n, radii })
+    }
+
+    /// [`CubeMap::build`] with the calls spread over the rayon pool by face rows; the first
+    /// invalid radius in table order is reported, as by the sequential build.
+    fn build_parallel(n: usize, r: &(dyn Fn(Unit<Vector3<f64>>) -> f64 + Sync)) -> Result<Self> {
+        let m = n + 1;
+        let rows: Vec<OnceLock<Vec<f64>>> = (0..6 * m).map(|_| OnceLock::new()).collect();
+        rows.par_iter().enumerate().for_each(|(row, slot)| {
+            let (f, q) = (row / m, row % m);
+            let _ = slot.set((0..m).map(|p| r(Self::direction(n, f, p, q))).collect());
+        });
+        Self::from_rows(n, &rows)
+    }
+
+    /// The table from its face rows (row `f·m + q` holds the nodes p = 0..m of face f, row
+    /// q), validated in table order.
+    fn from_rows(n: usize, rows: &[OnceLock<Vec<f64>>]) -> Result<Self> {
+        let m = n + 1;
+        let mut radii = Vec::with_capacity(6 * m * m);
+        for (row, slot) in rows.iter().enumerate() {
+            let (f, q) = (row / m, row % m);
+            let vals = slot.get().map_or(&[][..], Vec::as_slice);
+            for p in 0..m {
+                // A missing row (only after a panic elsewhere) reads as an invalid radius.
+                let v = vals.get(p).copied().unwrap_or(f64::NAN);
+                if !(v.is_finite() && v > 0.0) {
+                    checked_radius(Self::direction(n, f, p, q), v)?;
+                }
+                radii.push(v as f32);
             }
         }
         Ok(Self { n, radii })
@@ -235,7 +265,8 @@ impl Grid {
     /// inside the grid box; the surface should be too (parts outside the box are clipped).
     ///
     /// Calls: `6·(face_cells+1)²` with the default cube map (6534 for `face_cells = 32`),
-    /// or exactly one per node with [`DirectionTable::Exact`].
+    /// or exactly one per node with [`DirectionTable::Exact`], always on the calling thread
+    /// ([`Grid::from_star_sync`] spreads them over the rayon pool).
     ///
     /// # Errors
     /// Invalid spec or params, a radius that is not finite and positive
@@ -247,119 +278,270 @@ impl Grid {
         mut radius: impl FnMut(Unit<Vector3<f64>>) -> f64,
         params: &StarParams,
     ) -> Result<(Self, StarBuild)> {
-        spec.validate()?;
-        params.validate()?;
-        for a in 0..3 {
-            if !centre[a].is_finite() {
-                return Err(Error::InvalidParameter {
-                    name: "centre",
-                    value: centre[a],
-                    requirement: "finite",
-                });
-            }
-        }
-        let [nx, ny, nz] = spec.dims;
-        let mut values = Vec::with_capacity(spec.len());
-        let h = spec.spacing;
-        let calls;
-        match params.table {
+        check_star(&spec, centre, params)?;
+        let radii = match params.table {
             DirectionTable::CubeMap { face_cells } => {
-                let map = CubeMap::build(face_cells, &mut radius)?;
-                calls = map.radii.len();
-                // Narrow shell: interpolated radii lie in [r_min, r_max], so nodes with
-                // ρ < r_min − 2h are inside and nodes with ρ > r_max + 2h outside, and
-                // neither touches the interface; they start at ∓∞ (far marker) and get
-                // their distance from the sweeps. Only the shell is looked up.
-                let (rmin, rmax) = map
-                    .radii
-                    .iter()
-                    .fold((f64::INFINITY, 0.0f64), |(a, b), &r| {
-                        (a.min(f64::from(r)), b.max(f64::from(r)))
-                    });
-                // The band build needs radii wherever a node or its stencil can be within
-                // BAND_CELLS·h of the surface.
-                let w = match params.redistance {
-                    Redistance::FullSweep => 2.0 * h,
-                    Redistance::Band => (BAND_CELLS + 1.5) * h,
-                };
-                let inner = (rmin - w).max(0.0);
-                let inner2 = inner * inner;
-                let outer2 = (rmax + w) * (rmax + w);
-                let o = spec.origin - centre;
-                // Per column: x and 1/|x| (the per-node division of the face coordinates
-                // becomes a table lookup).
-                let xs: Vec<f64> = (0..nx).map(|i| o.x + h * i as f64).collect();
-                let inv_x: Vec<f64> = xs.iter().map(|x| 1.0 / x.abs()).collect();
-                values.resize(spec.len(), FAR);
-                let fill = |k: usize, slab: &mut [f64]| {
-                    let z = o.z + h * k as f64;
-                    let inv_z = 1.0 / z.abs();
-                    for (j, row) in slab.chunks_exact_mut(nx).enumerate() {
-                        let y = o.y + h * j as f64;
-                        let yz2 = y * y + z * z;
-                        if yz2 > outer2 {
-                            // The whole row is outside the shell (already FAR).
-                            continue;
-                        }
-                        let inv_y = 1.0 / y.abs();
-                        for ((v, &x), &ix) in row.iter_mut().zip(&xs).zip(&inv_x) {
-                            let rho2 = x * x + yz2;
-                            *v = if rho2 < inner2 {
-                                -FAR
-                            } else if rho2 > outer2 {
-                                FAR
-                            } else if rho2 > 1e-24 * h * h {
-                                rho2.sqrt() - map.radius_inv(x, y, z, [ix, inv_y, inv_z])
-                            } else {
-                                -map.radius(&Vector3::z())
-                            };
-                        }
-                    }
-                };
-                for_each_slab(&mut values, nx * ny, params.parallel, fill);
+                Radii::Map(CubeMap::build(face_cells, &mut radius)?)
             }
             DirectionTable::Exact => {
-                let mut count = 0usize;
-                for k in 0..nz {
-                    for j in 0..ny {
-                        for i in 0..nx {
-                            let d = spec.node(i, j, k) - centre;
-                            let rho = d.norm();
-                            let u = if rho > 1e-12 * h {
-                                Unit::new_unchecked(d / rho)
-                            } else {
-                                Vector3::z_axis()
-                            };
-                            let r = radius(u);
-                            count += 1;
-                            if !(r.is_finite() && r > 0.0) {
-                                return Err(Error::InvalidRadius {
-                                    value: r,
-                                    x: u.x,
-                                    y: u.y,
-                                    z: u.z,
-                                });
-                            }
-                            values.push(rho.max(0.0) - r);
-                        }
-                    }
+                let mut g = Vec::with_capacity(spec.len());
+                for c in 0..spec.len() {
+                    let (rho, u) = node_ray(&spec, centre, c);
+                    g.push(rho - checked_radius(u, radius(u))?);
                 }
-                calls = count;
+                Radii::Nodes(g)
+            }
+        };
+        star_grid(spec, centre, radii, params)
+    }
+
+    /// [`Grid::from_star`] for a radius function that can be shared between threads: with
+    /// [`StarParams::parallel`] the radius calls run on the rayon pool too (the cube map by
+    /// rows of its faces, the exact table by z-slabs). The grid, and the error of an invalid
+    /// radius (the first in table or node order), are those of [`Grid::from_star`], bit for
+    /// bit (tested).
+    ///
+    /// # Errors
+    /// As [`Grid::from_star`].
+    pub fn from_star_sync(
+        spec: GridSpec,
+        centre: &Point3<f64>,
+        radius: impl Fn(Unit<Vector3<f64>>) -> f64 + Sync,
+        params: &StarParams,
+    ) -> Result<(Self, StarBuild)> {
+        if !params.parallel {
+            return Self::from_star(spec, centre, radius, params);
+        }
+        check_star(&spec, centre, params)?;
+        let radii = match params.table {
+            DirectionTable::CubeMap { face_cells } => Radii::Calls {
+                face_cells,
+                radius: &radius,
+            },
+            DirectionTable::Exact => {
+                let plane = spec.dims[0] * spec.dims[1];
+                let mut rs = vec![0.0; spec.len()];
+                rs.par_chunks_mut(plane).enumerate().for_each(|(k, slab)| {
+                    for (i, r) in slab.iter_mut().enumerate() {
+                        *r = radius(node_ray(&spec, centre, plane * k + i).1);
+                    }
+                });
+                let mut g = rs;
+                for (c, v) in g.iter_mut().enumerate() {
+                    let (rho, u) = node_ray(&spec, centre, c);
+                    *v = rho - checked_radius(u, *v)?;
+                }
+                Radii::Nodes(g)
+            }
+        };
+        star_grid(spec, centre, radii, params)
+    }
+}
+
+/// Validation shared by the star builders.
+fn check_star(spec: &GridSpec, centre: &Point3<f64>, params: &StarParams) -> Result<()> {
+    spec.validate()?;
+    params.validate()?;
+    for a in 0..3 {
+        if !centre[a].is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "centre",
+                value: centre[a],
+                requirement: "finite",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Distance from the centre and direction of node `c` (+z at the centre itself).
+#[inline]
+fn node_ray(spec: &GridSpec, centre: &Point3<f64>, c: usize) -> (f64, Unit<Vector3<f64>>) {
+    let [nx, ny, _] = spec.dims;
+    let d = spec.node(c % nx, c / nx % ny, c / (nx * ny)) - centre;
+    let rho = d.norm();
+    let u = if rho > 1e-12 * spec.spacing {
+        Unit::new_unchecked(d / rho)
+    } else {
+        Vector3::z_axis()
+    };
+    (rho, u)
+}
+
+/// `r` if it is a valid radius (finite, positive) in direction `u`.
+#[inline]
+fn checked_radius(u: Unit<Vector3<f64>>, r: f64) -> Result<f64> {
+    if r.is_finite() && r > 0.0 {
+        Ok(r)
+    } else {
+        Err(Error::InvalidRadius {
+            value: r,
+            x: u.x,
+            y: u.y,
+            z: u.z,
+        })
+    }
+}
+
+/// The sampled radius function of a star build.
+enum Radii<'r> {
+    /// Cube-map table built on the calling thread.
+    Map(CubeMap),
+    /// Cube-map table still to tabulate, on the rayon pool, from a shareable function.
+    Calls {
+        face_cells: usize,
+        radius: &'r (dyn Fn(Unit<Vector3<f64>>) -> f64 + Sync),
+    },
+    /// The radial signed distance `ρ − r(û)` at every node (exact table).
+    Nodes(Vec<f64>),
+}
+
+/// The radial signed distances of the cube-map build in the shell of nodes that can be within
+/// the band (or the interface stencil) of the surface; ∓∞ (far marker, sign only) inside
+/// and outside the shell.
+struct Shell {
+    map: CubeMap,
+    nx: usize,
+    h: f64,
+    /// Grid origin relative to the centre.
+    o: Vector3<f64>,
+    /// Per column: x and 1/|x| (the per-node division of the face coordinates becomes a
+    /// table lookup).
+    xs: Vec<f64>,
+    inv_x: Vec<f64>,
+    inner2: f64,
+    outer2: f64,
+}
+
+impl Shell {
+    fn new(spec: &GridSpec, centre: &Point3<f64>, map: CubeMap, redist: Redistance) -> Self {
+        let h = spec.spacing;
+        // Narrow shell: interpolated radii lie in [r_min, r_max], so nodes with
+        // ρ < r_min − w are inside and nodes with ρ > r_max + w outside, and neither touches
+        // the interface (or the band); they start at ∓∞ (far marker) and get their value
+        // from the sweeps. Only the shell is looked up.
+        let (rmin, rmax) = map
+            .radii
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(a, b), &r| {
+                (a.min(f64::from(r)), b.max(f64::from(r)))
+            });
+        // The band build needs radii wherever a node or its stencil can be within
+        // BAND_CELLS·h of the surface.
+        let w = match redist {
+            Redistance::FullSweep => 2.0 * h,
+            Redistance::Band => (BAND_CELLS + 1.5) * h,
+        };
+        let inner = (rmin - w).max(0.0);
+        let o = spec.origin - centre;
+        let xs: Vec<f64> = (0..spec.dims[0]).map(|i| o.x + h * i as f64).collect();
+        let inv_x = xs.iter().map(|x| 1.0 / x.abs()).collect();
+        Self {
+            map,
+            nx: spec.dims[0],
+            h,
+            o,
+            xs,
+            inv_x,
+            inner2: inner * inner,
+            outer2: (rmax + w) * (rmax + w),
+        }
+    }
+
+    /// Writes the radial values of z-slab `k` over `slab` (which holds `FAR`).
+    #[inline]
+    fn fill(&self, k: usize, slab: &mut [f64]) {
+        let (h, o, map) = (self.h, self.o, &self.map);
+        let (inner2, outer2) = (self.inner2, self.outer2);
+        let z = o.z + h * k as f64;
+        let inv_z = 1.0 / z.abs();
+        for (j, row) in slab.chunks_exact_mut(self.nx).enumerate() {
+            let y = o.y + h * j as f64;
+            let yz2 = y * y + z * z;
+            if yz2 > outer2 {
+                // The whole row is outside the shell (already FAR).
+                continue;
+            }
+            let inv_y = 1.0 / y.abs();
+            for ((v, &x), &ix) in row.iter_mut().zip(&self.xs).zip(&self.inv_x) {
+                let rho2 = x * x + yz2;
+                *v = if rho2 < inner2 {
+                    -FAR
+                } else if rho2 > outer2 {
+                    FAR
+                } else if rho2 > 1e-24 * h * h {
+                    rho2.sqrt() - map.radius_inv(x, y, z, [ix, inv_y, inv_z])
+                } else {
+                    -map.radius(&Vector3::z())
+                };
             }
         }
-        // Far nodes hold ±∞ until the sweeps (which reach every node) give them a distance;
-        // `Grid::new` re-checks that everything ended finite.
+    }
+}
+
+/// The redistancing of a star build from its sampled radii.
+fn star_grid(
+    spec: GridSpec,
+    centre: &Point3<f64>,
+    radii: Radii<'_>,
+    params: &StarParams,
+) -> Result<(Grid, StarBuild)> {
+    let plane = spec.dims[0] * spec.dims[1];
+    let calls = match &radii {
+        Radii::Map(map) => map.radii.len(),
+        Radii::Calls { face_cells, .. } => 6 * (face_cells + 1) * (face_cells + 1),
+        Radii::Nodes(g) => g.len(),
+    };
+    let values = if params.parallel && params.redistance == Redistance::Band {
+        band_build_parallel(&spec, centre, radii)?
+    } else {
+        // The radial values (the exact table has them already). Far nodes hold ±∞ until the
+        // sweeps (which reach every node) give them a distance; `Grid::new` re-checks that
+        // everything ended finite.
+        let mut values = match radii {
+            Radii::Nodes(g) => g,
+            Radii::Map(_) | Radii::Calls { .. } => {
+                let map = match radii {
+                    Radii::Map(map) => map,
+                    Radii::Calls { face_cells, radius } => {
+                        CubeMap::build_parallel(face_cells, radius)?
+                    }
+                    Radii::Nodes(_) => unreachable!("handled above"),
+                };
+                let shell = Shell::new(&spec, centre, map, params.redistance);
+                let mut values = vec![FAR; spec.len()];
+                for_each_slab(&mut values, plane, params.parallel, |k, s| {
+                    shell.fill(k, s);
+                });
+                values
+            }
+        };
         match params.redistance {
             Redistance::FullSweep => redistance(&spec, &mut values, true)?,
-            Redistance::Band => band_redistance(&spec, centre, &mut values, params.parallel)?,
+            Redistance::Band => {
+                let (band, coarse) = far_field(&spec, &BandSlab::new(&spec, centre), &mut values)?;
+                coarse.assemble(&spec, &mut values, &band, params.parallel);
+            }
         }
-        Ok((
-            Grid::new(spec, values)?,
-            StarBuild {
-                radius_calls: calls,
-            },
-        ))
+        values
+    };
+    Ok((
+        Grid::new(spec, values)?,
+        StarBuild {
+            radius_calls: calls,
+        },
+    ))
+}
+
+/// The sequential band redistancing of the radial field `g` up to the far field: the band
+/// values (written over `g`) and the far field, or [`Error::NoSurface`].
+fn far_field(spec: &GridSpec, est: &BandSlab, g: &mut [f64]) -> Result<(Band, Coarse)> {
+    if !crosses(spec, g) {
+        return Err(Error::NoSurface);
     }
+    let band = band_values(spec, est, g);
+    let coarse = Coarse::interior(spec, g, &band)?;
+    Ok((band, coarse))
 }
 
 /// Runs `f(k, slab)` on every z-slab (`plane` values) of `values`, on the rayon pool if
@@ -382,10 +564,144 @@ fn for_each_slab(
     }
 }
 
-/// Second-order distance estimate from the radial distance `g` at an interior node with
-/// in-slab index `c` (strides 1, `sy`; `lo`, `mid`, `up` = the z-slabs below, at and above
-/// the node), or NaN if the stencil holds a far marker, the
-/// first-order estimate is not below `√cut2`, or a guard fails.
+/// The band build of [`StarParams::parallel`], in one pass over the rayon pool
+/// ([`crate::crew`]) with the phases: cube-map rows (if not yet tabulated) → the table and
+/// its shell → radial values per z-slab → band estimates per z-slab → (one item) the
+/// sequential band consistency check and far field → assembly per z-slab. Every slab does
+/// the arithmetic of the sequential build, in the same order, so the grid is bit-identical.
+fn band_build_parallel(
+    spec: &GridSpec,
+    centre: &Point3<f64>,
+    radii: Radii<'_>,
+) -> Result<Vec<f64>> {
+    let [nx, ny, nz] = spec.dims;
+    let plane = nx * ny;
+    let (premade, calls, nodes) = match radii {
+        Radii::Map(map) => (Some(map), None, None),
+        Radii::Calls { face_cells, radius } => (None, Some((face_cells, radius)), None),
+        Radii::Nodes(g) => (None, None, Some(g)),
+    };
+    let m = calls.map_or(0, |(n, _)| n + 1);
+    // Phase outputs, each written once.
+    let rows: Vec<OnceLock<Vec<f64>>> = (0..6 * m).map(|_| OnceLock::new()).collect();
+    let shell: OnceLock<Result<Shell>> = OnceLock::new();
+    if let Some(map) = premade {
+        let _ = shell.set(Ok(Shell::new(spec, centre, map, Redistance::Band)));
+    }
+    let radial: Vec<OnceLock<Vec<f64>>> = (0..nz).map(|_| OnceLock::new()).collect();
+    let found: Vec<OnceLock<Vec<(usize, f64)>>> = (0..nz).map(|_| OnceLock::new()).collect();
+    let field: OnceLock<Result<(Vec<f64>, Band, Coarse)>> = OnceLock::new();
+    let est = BandSlab::new(spec, centre);
+    let mut values = vec![0.0; spec.len()];
+    let out: Vec<Mutex<&mut [f64]>> = values.chunks_mut(plane).map(Mutex::new).collect();
+    let slab = |k: usize| -> Option<&[f64]> {
+        match &nodes {
+            Some(g) => Some(&g[plane * k..plane * (k + 1)]),
+            None => radial[k].get().map(Vec::as_slice),
+        }
+    };
+    let counts = [
+        6 * m,
+        usize::from(calls.is_some()),
+        if nodes.is_some() { 0 } else { nz },
+        nz - 2,
+        1,
+        nz,
+    ];
+    crew::run_phases(&counts, &|phase, i| match phase {
+        0 => {
+            if let Some((n, radius)) = calls {
+                let (f, q) = (i / m, i % m);
+                let row = (0..m)
+                    .map(|p| radius(CubeMap::direction(n, f, p, q)))
+                    .collect();
+                let _ = rows[i].set(row);
+            }
+        }
+        1 => {
+            if let Some((n, _)) = calls {
+                let map = CubeMap::from_rows(n, &rows);
+                let _ = shell.set(map.map(|map| Shell::new(spec, centre, map, Redistance::Band)));
+            }
+        }
+        2 => {
+            if let Some(Ok(shell)) = shell.get() {
+                let mut v = vec![FAR; plane];
+                shell.fill(i, &mut v);
+                let _ = radial[i].set(v);
+            }
+        }
+        3 => {
+            let k = i + 1;
+            if let (Some(lo), Some(mid), Some(up)) = (slab(k - 1), slab(k), slab(k + 1)) {
+                let mut f = Vec::new();
+                est.estimates(k, [lo, mid, up], &mut f);
+                let _ = found[k].set(f);
+            }
+        }
+        4 => {
+            let mut g = Vec::with_capacity(spec.len());
+            for k in 0..nz {
+                match slab(k) {
+                    Some(s) => g.extend_from_slice(s),
+                    // The radii were invalid (reported from the shell slot).
+                    None => return,
+                }
+            }
+            let r = if crosses(spec, &g) {
+                let mut b = BandBuilder::new(g.len());
+                for f in &found[1..nz - 1] {
+                    if let Some(f) = f.get() {
+                        b.apply(f, &mut g);
+                    }
+                }
+                let band = b.finish(spec, &mut g);
+                Coarse::interior(spec, &g, &band).map(|c| (g, band, c))
+            } else {
+                Err(Error::NoSurface)
+            };
+            let _ = field.set(r);
+        }
+        _ => {
+            if let (Some(Ok((g, band, coarse))), Ok(mut dst)) = (field.get(), out[i].lock()) {
+                dst.copy_from_slice(&g[plane * i..plane * (i + 1)]);
+                coarse.assemble_slab(spec, i, &mut dst, band);
+            }
+        }
+    });
+    drop(out);
+    if let Some(Err(e)) = shell.into_inner() {
+        return Err(e);
+    }
+    match field.into_inner() {
+        Some(Ok(_)) => Ok(values),
+        Some(Err(e)) => Err(e),
+        None => Err(Error::NoSurface),
+    }
+}
+
+/// The nine grid rows around a row of nodes: `rows[z][y]` for the z-slabs k − 1, k, k + 1
+/// and the rows j − 1, j, j + 1, each exactly `nx` long, so that a stencil at column
+/// `1 ≤ i < nx − 1` needs no bounds checks beyond the rows'.
+type Rows<'a> = [[&'a [f64]; 3]; 3];
+
+/// The nine rows of [`Rows`] around row `j` (in-slab offset `row = nx·j`) of the slabs
+/// `lo`, `mid`, `up`.
+#[inline]
+fn rows<'a>([lo, mid, up]: [&'a [f64]; 3], row: usize, nx: usize) -> Rows<'a> {
+    let three = |s: &'a [f64]| {
+        [
+            &s[row - nx..row],
+            &s[row..row + nx],
+            &s[row + nx..row + 2 * nx],
+        ]
+    };
+    [three(lo), three(mid), three(up)]
+}
+
+/// Second-order distance estimate from the radial distance `g` at the interior node in
+/// column `i` of the middle row of `r` (see [`Rows`]), or NaN if the stencil holds a far
+/// marker, the first-order estimate is not below `√cut2`, or a guard fails.
 ///
 /// Along the surface normal through the node, `g(t) = a·t + b·t²/2 + O(t³)` with
 /// `b = nᵀ(∇²g)n`; matching `g` and `|∇g|` at the node gives
@@ -393,17 +709,12 @@ fn for_each_slab(
 /// third-order otherwise (the first-order `g/|∇g|` of the seed errs by `b·d²/2`).
 /// Derivatives are central differences.
 #[inline]
-fn second_order_distance(
-    [lo, mid, up]: [&[f64]; 3],
-    c: usize,
-    sy: usize,
-    h: f64,
-    cut2: f64,
-) -> f64 {
-    let v = mid[c];
-    let (xl, xr) = (mid[c - 1], mid[c + 1]);
-    let (yl, yr) = (mid[c - sy], mid[c + sy]);
-    let (zl, zr) = (lo[c], up[c]);
+fn second_order_distance(r: &Rows<'_>, i: usize, h: f64, cut2: f64) -> f64 {
+    let [lo, mid, up] = r;
+    let v = mid[1][i];
+    let (xl, xr) = (mid[1][i - 1], mid[1][i + 1]);
+    let (yl, yr) = (mid[0][i], mid[2][i]);
+    let (zl, zr) = (lo[1][i], up[1][i]);
     let inv2h = 0.5 / h;
     let gx = (xr - xl) * inv2h;
     let gy = (yr - yl) * inv2h;
@@ -420,9 +731,9 @@ fn second_order_distance(
     let hyy = (yl - 2.0 * v + yr) * ih2;
     let hzz = (zl - 2.0 * v + zr) * ih2;
     let q = 0.25 * ih2;
-    let hxy = (mid[c + 1 + sy] - mid[c + 1 - sy] - mid[c - 1 + sy] + mid[c - 1 - sy]) * q;
-    let hxz = (up[c + 1] - lo[c + 1] - up[c - 1] + lo[c - 1]) * q;
-    let hyz = (up[c + sy] - lo[c + sy] - up[c - sy] + lo[c - sy]) * q;
+    let hxy = (mid[2][i + 1] - mid[0][i + 1] - mid[2][i - 1] + mid[0][i - 1]) * q;
+    let hxz = (up[1][i + 1] - lo[1][i + 1] - up[1][i - 1] + lo[1][i - 1]) * q;
+    let hyz = (up[2][i] - lo[2][i] - up[0][i] + lo[0][i]) * q;
     let b = (gx * gx * hxx
         + gy * gy * hyy
         + gz * gz * hzz
@@ -439,20 +750,22 @@ fn second_order_distance(
     2.0 * v / (gp2.sqrt() + (gp2 - 2.0 * bv).sqrt())
 }
 
-/// The seed's interface estimate at a node with a neighbour of the other sign (`None`
-/// otherwise): `|g|/|∇g|` (central differences), capped by the distance to the nearest linear
-/// zero crossing along a grid edge, with the sign of `g` (see [`crate::reinit`]).
+/// The seed's interface estimate at the node in column `i` of the middle row of `r` if it has
+/// a neighbour of the other sign (`None` otherwise): `|g|/|∇g|` (central differences), capped
+/// by the distance to the nearest linear zero crossing along a grid edge, with the sign of
+/// `g` (see [`crate::reinit`]).
 #[inline]
-fn interface_estimate([lo, mid, up]: [&[f64]; 3], c: usize, sy: usize, h: f64) -> Option<f64> {
-    let v = mid[c];
+fn interface_estimate(r: &Rows<'_>, i: usize, h: f64) -> Option<f64> {
+    let [lo, mid, up] = r;
+    let v = mid[1][i];
     let inside = v < 0.0;
     let nb = [
-        mid[c - 1],
-        mid[c + 1],
-        mid[c - sy],
-        mid[c + sy],
-        lo[c],
-        up[c],
+        mid[1][i - 1],
+        mid[1][i + 1],
+        mid[0][i],
+        mid[2][i],
+        lo[1][i],
+        up[1][i],
     ];
     let mut cap = f64::INFINITY;
     for w in nb {
@@ -478,24 +791,6 @@ fn interface_estimate([lo, mid, up]: [&[f64]; 3], c: usize, sy: usize, h: f64) -
         cap
     };
     Some(if inside { -est } else { est })
-}
-
-/// The narrow-band redistancing of [`Redistance::Band`]. `g` holds the radial signed
-/// distance at every node that can be within the band or its stencil, and ±∞ (sign only)
-/// elsewhere, and is overwritten with the result.
-fn band_redistance(
-    spec: &GridSpec,
-    centre: &Point3<f64>,
-    g: &mut [f64],
-    parallel: bool,
-) -> Result<()> {
-    if !crosses(spec, g) {
-        return Err(Error::NoSurface);
-    }
-    let band = band_values(spec, centre, g, parallel);
-    let coarse = Coarse::interior(spec, g, &band)?;
-    coarse.assemble(spec, g, &band, parallel);
-    Ok(())
 }
 
 /// Membership bits of the band nodes (one bit per node).
@@ -535,30 +830,42 @@ fn crosses(spec: &GridSpec, g: &[f64]) -> bool {
     false
 }
 
-/// Writes the second-order distances of the band nodes over the radial field `g` (other
-/// nodes keep their radial value) and returns the band membership. The estimates of every
-/// z-slab are computed from the radial field first (in parallel if asked), then written.
-#[inline(never)]
-fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64], parallel: bool) -> Band {
-    let [nx, ny, nz] = spec.dims;
-    let h = spec.spacing;
-    let sy = nx;
-    let plane = nx * ny;
-    let band_w = BAND_CELLS * h;
-    let o = spec.origin.coords - centre.coords;
-    let cut2 = (1.15 * band_w).powi(2);
-    let mut band = Band(vec![0; g.len().div_ceil(64)]);
-    // Appends the band estimates of slab k (`mid`, between `lo` and `up`, all radial
-    // values): (node index, value).
-    let slab = |k: usize, [lo, mid, up]: [&[f64]; 3], found: &mut Vec<(usize, f64)>| {
+/// The band estimates of one z-slab (see [`Redistance::Band`]).
+struct BandSlab {
+    dims: [usize; 3],
+    h: f64,
+    band_w: f64,
+    /// Grid origin relative to the centre.
+    o: Vector3<f64>,
+    cut2: f64,
+}
+
+impl BandSlab {
+    fn new(spec: &GridSpec, centre: &Point3<f64>) -> Self {
+        let band_w = BAND_CELLS * spec.spacing;
+        Self {
+            dims: spec.dims,
+            h: spec.spacing,
+            band_w,
+            o: spec.origin.coords - centre.coords,
+            cut2: (1.15 * band_w).powi(2),
+        }
+    }
+
+    /// Appends the band estimates of the interior slab k (`mid`, between `lo` and `up`, all
+    /// radial values) to `found`: (node index, value).
+    fn estimates(&self, k: usize, [lo, mid, up]: [&[f64]; 3], found: &mut Vec<(usize, f64)>) {
+        let [nx, ny, _] = self.dims;
+        let (h, o, cut2, band_w) = (self.h, self.o, self.cut2, self.band_w);
+        let plane = nx * ny;
         let z = o.z + h * k as f64;
         for j in 1..ny - 1 {
-            let row = sy * j;
+            let row = nx * j;
             let y = o.y + h * j as f64;
             let yz2 = y * y + z * z;
-            for i in 1..nx - 1 {
+            let r = rows([lo, mid, up], row, nx);
+            for (i, &v) in r[1][1].iter().enumerate().take(nx - 1).skip(1) {
                 let c = row + i;
-                let v = mid[c];
                 // Cheap screen first: the first-order estimate |g|/|∇g| with |∇g| ≤ 2
                 // must be below 1.15 band widths (a node needing a larger second-order
                 // correction takes the far field). The radial field is singular at the
@@ -570,13 +877,13 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64], parallel: b
                 let d = if v * v >= 4.0 * cut2 || v * v > x * x + yz2 {
                     f64::NAN
                 } else {
-                    second_order_distance([lo, mid, up], c, sy, h, cut2)
+                    second_order_distance(&r, i, h, cut2)
                 };
                 if d.abs() < band_w {
                     found.push((plane * k + c, d));
                 } else if let Some(e) = v
                     .is_finite()
-                    .then(|| interface_estimate([lo, mid, up], c, sy, h))
+                    .then(|| interface_estimate(&r, i, h))
                     .flatten()
                 {
                     // A node next to the surface where the expansion is not trusted:
@@ -585,85 +892,101 @@ fn band_values(spec: &GridSpec, centre: &Point3<f64>, g: &mut [f64], parallel: b
                 }
             }
         }
-    };
-    // The interior band nodes, for the consistency check.
-    let mut inner = Vec::new();
-    let mut apply = |found: &[(usize, f64)], g: &mut [f64]| {
+    }
+}
+
+/// Band membership under construction: estimates are written over the radial field slab by
+/// slab, in slab order.
+struct BandBuilder {
+    band: Band,
+    /// The interior band nodes, for the consistency check.
+    inner: Vec<usize>,
+}
+
+impl BandBuilder {
+    fn new(len: usize) -> Self {
+        Self {
+            band: Band(vec![0; len.div_ceil(64)]),
+            inner: Vec::new(),
+        }
+    }
+
+    fn apply(&mut self, found: &[(usize, f64)], g: &mut [f64]) {
         for &(c, d) in found {
             g[c] = d;
-            band.set(c, true);
+            self.band.set(c, true);
             if d < 0.0 {
-                inner.push(c);
+                self.inner.push(c);
             }
         }
-    };
-    if parallel {
-        let src: &[f64] = g;
-        let slabs: Vec<Vec<(usize, f64)>> = (1..nz - 1)
-            .into_par_iter()
-            .map(|k| {
-                let mut f = Vec::new();
-                let s = |k: usize| &src[plane * k..plane * (k + 1)];
-                slab(k, [s(k - 1), s(k), s(k + 1)], &mut f);
-                f
-            })
-            .collect();
-        for f in &slabs {
-            apply(f, g);
-        }
-    } else {
-        // The stencils read the radial field: copies of slabs k − 1 and k keep their radial
-        // values while slab k is overwritten.
-        let mut lo = g[..plane].to_vec();
-        let mut mid = vec![0.0; plane];
-        let mut found = Vec::new();
-        for k in 1..nz - 1 {
-            mid.copy_from_slice(&g[plane * k..plane * (k + 1)]);
-            found.clear();
-            slab(
-                k,
-                [&lo, &mid, &g[plane * (k + 1)..plane * (k + 2)]],
-                &mut found,
-            );
-            apply(&found, g);
-            std::mem::swap(&mut lo, &mut mid);
-        }
     }
-    // Consistency check: near a ridge of the distance (the medial axis, which reaches the
-    // surface at convex kinks of r), the expansion can err without its guards noticing;
-    // there the band values break |∇φ| = 1. An interior band node whose six neighbours are
-    // band nodes and whose central-difference gradient norm is off by more than
-    // EIKONAL_SLACK leaves the band (one pass, on the values before the pass) and takes the
-    // far field.
-    let sz = plane;
-    let mut demote = Vec::new();
-    let (lo2, hi2) = (
-        (1.0 - EIKONAL_SLACK).powi(2) * 4.0 * h * h,
-        (1.0 + EIKONAL_SLACK).powi(2) * 4.0 * h * h,
-    );
-    // Outside, the far field is only a bound: exterior band values are kept. Band nodes are
-    // interior grid nodes, so their six neighbours exist.
-    for &c in &inner {
-        // Nodes next to the surface stay (their far-field value would be poor).
-        let nb = [c - 1, c + 1, c - sy, c + sy, c - sz, c + sz];
-        if !nb.iter().all(|&q| band.has(q) && g[q] < 0.0) {
-            continue;
+
+    /// Consistency check: near a ridge of the distance (the medial axis, which reaches the
+    /// surface at convex kinks of r), the expansion can err without its guards noticing;
+    /// there the band values break |∇φ| = 1. An interior band node whose six neighbours are
+    /// band nodes and whose central-difference gradient norm is off by more than
+    /// EIKONAL_SLACK leaves the band (one pass, on the values before the pass) and takes the
+    /// far field.
+    fn finish(self, spec: &GridSpec, g: &mut [f64]) -> Band {
+        let Self { mut band, inner } = self;
+        let [nx, ny, _] = spec.dims;
+        let h = spec.spacing;
+        let (sy, sz) = (nx, nx * ny);
+        let mut demote = Vec::new();
+        let (lo2, hi2) = (
+            (1.0 - EIKONAL_SLACK).powi(2) * 4.0 * h * h,
+            (1.0 + EIKONAL_SLACK).powi(2) * 4.0 * h * h,
+        );
+        // Outside, the far field is only a bound: exterior band values are kept. Band nodes
+        // are interior grid nodes, so their six neighbours exist.
+        for &c in &inner {
+            // Nodes next to the surface stay (their far-field value would be poor).
+            let nb = [c - 1, c + 1, c - sy, c + sy, c - sz, c + sz];
+            if !nb.iter().all(|&q| band.has(q) && g[q] < 0.0) {
+                continue;
+            }
+            let gx = g[c + 1] - g[c - 1];
+            let gy = g[c + sy] - g[c - sy];
+            let gz = g[c + sz] - g[c - sz];
+            let n2 = gx * gx + gy * gy + gz * gz;
+            if n2 > hi2 || n2 < lo2 {
+                demote.push(c);
+            }
         }
-        let gx = g[c + 1] - g[c - 1];
-        let gy = g[c + sy] - g[c - sy];
-        let gz = g[c + sz] - g[c - sz];
-        let n2 = gx * gx + gy * gy + gz * gz;
-        if n2 > hi2 || n2 < lo2 {
-            demote.push(c);
+        for c in demote {
+            band.set(c, false);
+            // Its radial value is gone; −∞ (sign only, no bound) keeps the suspect band value
+            // from clamping the far field that replaces it.
+            g[c] = f64::NEG_INFINITY;
         }
+        band
     }
-    for c in demote {
-        band.set(c, false);
-        // Its radial value is gone; −∞ (sign only, no bound) keeps the suspect band value
-        // from clamping the far field that replaces it.
-        g[c] = f64::NEG_INFINITY;
+}
+
+/// Writes the second-order distances of the band nodes over the radial field `g` (other
+/// nodes keep their radial value) and returns the band membership (sequential: the stencils
+/// read copies of the slabs below, which keep their radial values while slab k is
+/// overwritten).
+#[inline(never)]
+fn band_values(spec: &GridSpec, est: &BandSlab, g: &mut [f64]) -> Band {
+    let [nx, ny, nz] = spec.dims;
+    let plane = nx * ny;
+    let mut b = BandBuilder::new(g.len());
+    let mut lo = g[..plane].to_vec();
+    let mut mid = vec![0.0; plane];
+    let mut found = Vec::new();
+    for k in 1..nz - 1 {
+        mid.copy_from_slice(&g[plane * k..plane * (k + 1)]);
+        found.clear();
+        est.estimates(
+            k,
+            [&lo, &mid, &g[plane * (k + 1)..plane * (k + 2)]],
+            &mut found,
+        );
+        b.apply(&found, g);
+        std::mem::swap(&mut lo, &mut mid);
     }
-    band
+    b.finish(spec, g)
 }
 
 /// Value of an exterior node outside the band: `min(|g|, BAND_CELLS·h)`, the band width
@@ -680,8 +1003,9 @@ fn exterior_value(g: f64, band_w: f64) -> f64 {
 /// grid on an axis with an odd number of cells), padded by one node.
 struct Coarse {
     m: [usize; 3],
-    /// Signed coarse values, padded layout.
-    dist: Vec<f64>,
+    /// The signed coarse values interpolated along x to every fine column: `nx` values per
+    /// coarse row (row `jc + m[1]·kc`).
+    ax: Vec<f64>,
 }
 
 impl Coarse {
@@ -811,21 +1135,6 @@ impl Coarse {
                 dist[p] = -dist[p].sqrt();
             }
         }
-        Ok(Self { m, dist })
-    }
-
-    /// Fine values, written over `g`: trusted band values; elsewhere inside, the trilinear
-    /// interpolation of the coarse values (separably: x, then y, then z); elsewhere outside,
-    /// [`exterior_value`].
-    #[inline(never)]
-    fn assemble(&self, spec: &GridSpec, g: &mut [f64], band: &Band, parallel: bool) {
-        let [nx, ny, _] = spec.dims;
-        let h = spec.spacing;
-        let (sy, sz) = (nx, nx * ny);
-        let m = self.m;
-        let (px, py) = (m[0] + 2, m[1] + 2);
-        let pz = px * py;
-        let dist = &self.dist;
         let mut ax = vec![0.0; nx * m[1] * m[2]];
         for kc in 0..m[2] {
             for jc in 0..m[1] {
@@ -841,52 +1150,68 @@ impl Coarse {
                 }
             }
         }
+        Ok(Self { m, ax })
+    }
+
+    /// Fine values, written over `g`: trusted band values; elsewhere inside, the trilinear
+    /// interpolation of the coarse values (separably: x, then y, then z); elsewhere outside,
+    /// [`exterior_value`].
+    #[inline(never)]
+    fn assemble(&self, spec: &GridSpec, g: &mut [f64], band: &Band, parallel: bool) {
+        let plane = spec.dims[0] * spec.dims[1];
+        for_each_slab(g, plane, parallel, |k, slab| {
+            self.assemble_slab(spec, k, slab, band);
+        });
+    }
+
+    /// [`Coarse::assemble`] of z-slab `k`.
+    fn assemble_slab(&self, spec: &GridSpec, k: usize, slab: &mut [f64], band: &Band) {
+        let [nx, ny, _] = spec.dims;
+        let h = spec.spacing;
+        let (sy, sz) = (nx, nx * ny);
+        let m = self.m;
+        let ax = &self.ax;
         let band_w = BAND_CELLS * h;
-        let ax = &ax;
-        let fill = |k: usize, slab: &mut [f64]| {
-            for j in 0..ny {
-                let dst = sy * j;
-                // The (up to four) coarse rows around the fine row and their weights.
-                let (j0, j1) = (j / 2, j.div_ceil(2));
-                let (k0, k1) = (k / 2, k.div_ceil(2));
-                let r = [
-                    nx * (j0 + m[1] * k0),
-                    nx * (j1 + m[1] * k0),
-                    nx * (j0 + m[1] * k1),
-                    nx * (j1 + m[1] * k1),
-                ];
-                for i in 0..nx {
-                    let c = dst + i;
-                    let b = slab[c];
-                    let in_band = band.has(sz * k + c);
-                    let inside = b < 0.0;
-                    // Band values within the sources, and outside (where the far field is
-                    // only a bound), are kept.
-                    if in_band && (b.abs() <= SOURCE_CELLS * h || !inside) {
-                        continue;
-                    }
-                    if !inside {
-                        slab[c] = exterior_value(b, band_w);
-                        continue;
-                    }
-                    let interp = 0.25 * (ax[r[0] + i] + ax[r[1] + i] + ax[r[2] + i] + ax[r[3] + i]);
-                    // Inside beyond the sources a band value must agree with the far field
-                    // (robust near ridges, where an expansion can underestimate); an
-                    // interpolated value of the other sign (next to the surface) is small, and
-                    // only its magnitude is kept.
-                    if !(in_band && (b - interp).abs() <= AGREEMENT * h) {
-                        // Off the band, `b` is still the radial distance |ρ − r(û)|: the
-                        // surface point on the node's ray is that far, so it bounds the
-                        // distance from above. The far field can exceed it where no source
-                        // is near (thin tips of rough grains, whose nodes leave the band):
-                        // clamp.
-                        let v = interp.abs();
-                        slab[c] = -(if in_band { v } else { v.min(b.abs()) });
-                    }
+        for j in 0..ny {
+            let dst = sy * j;
+            // The (up to four) coarse rows around the fine row and their weights.
+            let (j0, j1) = (j / 2, j.div_ceil(2));
+            let (k0, k1) = (k / 2, k.div_ceil(2));
+            let r = [
+                nx * (j0 + m[1] * k0),
+                nx * (j1 + m[1] * k0),
+                nx * (j0 + m[1] * k1),
+                nx * (j1 + m[1] * k1),
+            ];
+            for i in 0..nx {
+                let c = dst + i;
+                let b = slab[c];
+                let in_band = band.has(sz * k + c);
+                let inside = b < 0.0;
+                // Band values within the sources, and outside (where the far field is only a
+                // bound), are kept.
+                if in_band && (b.abs() <= SOURCE_CELLS * h || !inside) {
+                    continue;
+                }
+                if !inside {
+                    slab[c] = exterior_value(b, band_w);
+                    continue;
+                }
+                let interp = 0.25 * (ax[r[0] + i] + ax[r[1] + i] + ax[r[2] + i] + ax[r[3] + i]);
+                // Inside beyond the sources a band value must agree with the far field
+                // (robust near ridges, where an expansion can underestimate); an interpolated
+                // value of the other sign (next to the surface) is small, and only its
+                // magnitude is kept.
+                if !(in_band && (b - interp).abs() <= AGREEMENT * h) {
+                    // Off the band, `b` is still the radial distance |ρ − r(û)|: the surface
+                    // point on the node's ray is that far, so it bounds the distance from
+                    // above. The far field can exceed it where no source is near (thin tips
+                    // of rough grains, whose nodes leave the band): clamp.
+                    let v = interp.abs();
+                    slab[c] = -(if in_band { v } else { v.min(b.abs()) });
                 }
             }
-        };
-        for_each_slab(g, sz, parallel, fill);
+        }
     }
 }
 
@@ -1019,26 +1344,76 @@ mod tests {
 
     #[test]
     fn parallel_build_is_bit_identical() {
-        // Odd and even sizes, an off-centre lumpy grain touching several slabs' boundaries.
+        // Odd and even sizes, an off-centre lumpy grain touching several slabs' boundaries,
+        // both direction tables, and pools of 1, 2, 3 and 7 threads (chunkings of the slabs).
         let lumpy = |u: Unit<Vector3<f64>>| {
             0.7 + 0.15 * (3.0 * u.z).sin() * (2.0 * u.x).cos() + 0.05 * (5.0 * u.y).sin()
+        };
+        let same = |a: &Grid, b: &Grid| {
+            a.values()
+                .iter()
+                .zip(b.values())
+                .all(|(a, b)| a.to_bits() == b.to_bits())
         };
         for n in [20, 45] {
             let spec = GridSpec::cube(n, -1.2, 1.2).expect("spec");
             let c = Point3::new(0.05, -0.03, 0.02);
-            let (seq, _) = Grid::from_star(spec, &c, lumpy, &StarParams::default()).expect("s");
-            let par = StarParams {
-                parallel: true,
+            for table in [
+                DirectionTable::CubeMap { face_cells: 32 },
+                DirectionTable::Exact,
+            ] {
+                let seq_p = StarParams {
+                    table,
+                    ..StarParams::default()
+                };
+                let par = StarParams {
+                    parallel: true,
+                    ..seq_p
+                };
+                let (seq, sb) = Grid::from_star(spec, &c, lumpy, &seq_p).expect("s");
+                for threads in [1, 2, 3, 7] {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .expect("pool");
+                    let (p, pb) = pool
+                        .install(|| Grid::from_star(spec, &c, lumpy, &par))
+                        .expect("p");
+                    let (q, qb) = pool
+                        .install(|| Grid::from_star_sync(spec, &c, lumpy, &par))
+                        .expect("q");
+                    assert!(same(&seq, &p), "n = {n}, {table:?}, {threads} threads");
+                    assert!(
+                        same(&seq, &q),
+                        "sync: n = {n}, {table:?}, {threads} threads"
+                    );
+                    assert_eq!((sb, sb), (pb, qb));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn parallel_radius_errors_match_the_sequential_ones() {
+        let spec = GridSpec::cube(12, -1.2, 1.2).expect("spec");
+        // Invalid in several places: the first one in table (node) order is reported.
+        let bad = |u: Unit<Vector3<f64>>| if u.x > 0.3 || u.z < -0.5 { -1.0 } else { 1.0 };
+        for table in [
+            DirectionTable::CubeMap { face_cells: 8 },
+            DirectionTable::Exact,
+        ] {
+            let p = StarParams {
+                table,
                 ..StarParams::default()
             };
-            let (p, _) = Grid::from_star(spec, &c, lumpy, &par).expect("p");
-            assert!(
-                seq.values()
-                    .iter()
-                    .zip(p.values())
-                    .all(|(a, b)| a.to_bits() == b.to_bits()),
-                "n = {n}"
-            );
+            let par = StarParams {
+                parallel: true,
+                ..p
+            };
+            let e = Grid::from_star(spec, &Point3::origin(), bad, &p).map(|_| ());
+            let f = Grid::from_star_sync(spec, &Point3::origin(), bad, &par).map(|_| ());
+            assert!(matches!(e, Err(Error::InvalidRadius { .. })));
+            assert_eq!(format!("{e:?}"), format!("{f:?}"));
         }
     }
 
