@@ -24,9 +24,10 @@ impl Drop for Done<'_> {
 }
 
 /// Runs `work(phase, item)` for every `item < counts[phase]`, phase after phase (every item
-/// of a phase finishes before any item of the next starts), on all threads of the current
-/// rayon pool. Within a phase, items run in any order and on any thread.
-pub(crate) fn run_phases(counts: &[usize], work: &(impl Fn(usize, usize) + Sync)) {
+/// of a phase finishes before any item of the next starts): on all threads of the current
+/// rayon pool if `parallel` (items of a phase in any order, on any thread), else in order on
+/// the calling thread.
+pub(crate) fn run_phases(counts: &[usize], parallel: bool, work: &(impl Fn(usize, usize) + Sync)) {
     let claimed: Vec<AtomicUsize> = counts.iter().map(|_| AtomicUsize::new(0)).collect();
     let done: Vec<AtomicUsize> = counts.iter().map(|_| AtomicUsize::new(0)).collect();
     let panicked = AtomicBool::new(false);
@@ -43,18 +44,30 @@ pub(crate) fn run_phases(counts: &[usize], work: &(impl Fn(usize, usize) + Sync)
                 std::mem::forget(ok);
                 drop(guard);
             }
+            let mut spins = 0u32;
             while done[p].load(Ordering::Acquire) < n {
                 if panicked.load(Ordering::Relaxed) {
                     return;
                 }
-                std::hint::spin_loop();
+                // Spin (the wait is usually a few µs), then yield the core to whatever else
+                // is runnable (an oversubscribed pool, a lane descheduled mid-item).
+                if spins < 4096 {
+                    spins += 1;
+                    std::hint::spin_loop();
+                } else {
+                    std::thread::yield_now();
+                }
             }
             if panicked.load(Ordering::Relaxed) {
                 return;
             }
         }
     };
-    let lanes = rayon::current_num_threads();
+    let lanes = if parallel {
+        rayon::current_num_threads()
+    } else {
+        1
+    };
     if lanes <= 1 {
         lane();
         return;
@@ -91,7 +104,7 @@ mod tests {
             let log = Mutex::new(Vec::new());
             let counts = [5, 0, 1, 17, 3];
             pool.install(|| {
-                run_phases(&counts, &|p, i| {
+                run_phases(&counts, threads > 1, &|p, i| {
                     log.lock().expect("log").push((p, i));
                 });
             });
@@ -118,7 +131,7 @@ mod tests {
             .expect("pool");
         let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             pool.install(|| {
-                run_phases(&[4, 4], &|p, i| {
+                run_phases(&[4, 4], true, &|p, i| {
                     assert!(!(p == 0 && i == 2), "item failed");
                 });
             });

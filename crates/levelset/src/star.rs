@@ -31,10 +31,14 @@
 //! nodes does not fit a 32 KB L1 cache; 26 KB does) and the reciprocals of the node
 //! coordinates are tabulated per column and row, so a lookup has no division.
 //!
-//! [`StarParams::parallel`] runs the lookups, the band estimates and the assembly per z-slab
-//! on the rayon pool (the cube-map table, the far-field sweeps and the band consistency
-//! check stay sequential); every slab does the same arithmetic as the sequential build, so
-//! the grids are bit-identical (tested).
+//! The band build runs as phases over z-slabs (radial lookups, band estimates, their
+//! write-back, the band consistency check, the far field, assembly). With
+//! [`StarParams::parallel`] the phases run on the rayon pool in one cooperative pass
+//! ([`crate::crew`]: one pool wake-up per build instead of one per parallel pass, which on a
+//! 2-vCPU virtual machine cost 80–135 µs each); [`Grid::from_star_sync`] also spreads the
+//! radius calls of the cube map. Only the table's validation and the far-field sweeps stay
+//! sequential. Every slab does the same arithmetic in either mode, so the grids are
+//! bit-identical for any thread count (tested with 1, 2, 3 and 7 threads).
 
 use nalgebra::{Point3, Unit, Vector3};
 
@@ -43,7 +47,8 @@ use crate::error::{Error, Result};
 use crate::grid::{Grid, GridSpec};
 use crate::reinit::redistance;
 use rayon::prelude::*;
-use std::sync::{Mutex, OnceLock};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{OnceLock, RwLock};
 
 /// How the radius function is sampled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,13 +103,15 @@ pub struct StarParams {
     pub table: DirectionTable,
     /// Redistancing method.
     pub redistance: Redistance,
-    /// Split the per-node passes of the build (radial lookups, band estimates, assembly)
-    /// over z-slabs on the rayon pool (default `false`: callers that build many grids, like
-    /// the cloner, parallelise over grids instead). The radius function is still called on
-    /// the calling thread, and the result is bit-identical to the sequential build.
-    /// Measured on a 2-vCPU machine: 0–25 % faster on 45³ (the sequential parts, the
-    /// radius calls among them, are ≈ 30 % of the build, and the pool wakes three times per
-    /// build); more cores and larger grids gain more.
+    /// Run the per-slab passes of the band build (radial lookups, band estimates, consistency
+    /// check, assembly) on the rayon pool in one cooperative pass (default `false`: callers
+    /// that build many grids, like the cloner, parallelise over grids instead). With
+    /// [`Grid::from_star`] the radius function is still called on the calling thread; with
+    /// [`Grid::from_star_sync`] the calls are spread too. The result is bit-identical to the
+    /// sequential build. Measured on a 2-vCPU machine, 45³ (criterion medians of
+    /// `benches/acceptance.rs`): 1.62 ms against 2.75 ms sequential for a 5 ns radius
+    /// function, 2.21 ms for a 62 ns one. The pool's threads spin between phases, so a build
+    /// keeps every pool thread busy until it returns.
     pub parallel: bool,
 }
 
@@ -492,38 +499,32 @@ fn star_grid(
         Radii::Calls { face_cells, .. } => 6 * (face_cells + 1) * (face_cells + 1),
         Radii::Nodes(g) => g.len(),
     };
-    let values = if params.parallel && params.redistance == Redistance::Band {
-        band_build_parallel(&spec, centre, radii)?
-    } else {
-        // The radial values (the exact table has them already). Far nodes hold ±∞ until the
-        // sweeps (which reach every node) give them a distance; `Grid::new` re-checks that
-        // everything ended finite.
-        let mut values = match radii {
-            Radii::Nodes(g) => g,
-            Radii::Map(_) | Radii::Calls { .. } => {
-                let map = match radii {
-                    Radii::Map(map) => map,
-                    Radii::Calls { face_cells, radius } => {
-                        CubeMap::build_parallel(face_cells, radius)?
-                    }
-                    Radii::Nodes(_) => unreachable!("handled above"),
-                };
-                let shell = Shell::new(&spec, centre, map, params.redistance);
-                let mut values = vec![FAR; spec.len()];
-                for_each_slab(&mut values, plane, params.parallel, |k, s| {
-                    shell.fill(k, s);
-                });
-                values
-            }
-        };
-        match params.redistance {
-            Redistance::FullSweep => redistance(&spec, &mut values, true)?,
-            Redistance::Band => {
-                let (band, coarse) = far_field(&spec, &BandSlab::new(&spec, centre), &mut values)?;
-                coarse.assemble(&spec, &mut values, &band, params.parallel);
-            }
+    let values = match params.redistance {
+        Redistance::Band => band_build(&spec, centre, radii, params.parallel)?,
+        Redistance::FullSweep => {
+            // Far nodes hold ±∞ until the sweeps (which reach every node) give them a
+            // distance; `Grid::new` re-checks that everything ended finite.
+            let mut values = match radii {
+                Radii::Nodes(g) => g,
+                Radii::Map(_) | Radii::Calls { .. } => {
+                    let map = match radii {
+                        Radii::Calls { face_cells, radius } => {
+                            CubeMap::build_parallel(face_cells, radius)?
+                        }
+                        Radii::Map(map) => map,
+                        Radii::Nodes(_) => unreachable!("matched above"),
+                    };
+                    let shell = Shell::new(&spec, centre, map, params.redistance);
+                    let mut values = vec![FAR; spec.len()];
+                    for_each_slab(&mut values, plane, params.parallel, |k, s| {
+                        shell.fill(k, s);
+                    });
+                    values
+                }
+            };
+            redistance(&spec, &mut values, true)?;
+            values
         }
-        values
     };
     Ok((
         Grid::new(spec, values)?,
@@ -531,17 +532,6 @@ fn star_grid(
             radius_calls: calls,
         },
     ))
-}
-
-/// The sequential band redistancing of the radial field `g` up to the far field: the band
-/// values (written over `g`) and the far field, or [`Error::NoSurface`].
-fn far_field(spec: &GridSpec, est: &BandSlab, g: &mut [f64]) -> Result<(Band, Coarse)> {
-    if !crosses(spec, g) {
-        return Err(Error::NoSurface);
-    }
-    let band = band_values(spec, est, g);
-    let coarse = Coarse::interior(spec, g, &band)?;
-    Ok((band, coarse))
 }
 
 /// Runs `f(k, slab)` on every z-slab (`plane` values) of `values`, on the rayon pool if
@@ -564,23 +554,44 @@ fn for_each_slab(
     }
 }
 
-/// The band build of [`StarParams::parallel`], in one pass over the rayon pool
-/// ([`crate::crew`]) with the phases: cube-map rows (if not yet tabulated) → the table and
-/// its shell → radial values per z-slab → band estimates per z-slab → (one item) the
-/// sequential band consistency check and far field → assembly per z-slab. Every slab does
-/// the arithmetic of the sequential build, in the same order, so the grid is bit-identical.
-fn band_build_parallel(
+/// The band estimates of one z-slab.
+struct SlabBand {
+    /// Band nodes and their values (in-slab indices).
+    found: Vec<(usize, f64)>,
+    /// Band membership bits of the slab.
+    bits: Vec<u64>,
+    /// The interior band nodes, for the consistency check.
+    inner: Vec<usize>,
+}
+
+/// The narrow-band redistancing of [`Redistance::Band`], as phases over z-slabs
+/// ([`crate::crew`]; on the rayon pool if `parallel`, else in order on the calling thread):
+///
+/// 0. cube-map rows (only for [`Radii::Calls`]); 1. the table and its shell;
+/// 2. radial values per slab (into the output grid); 3. band estimates per slab
+///    (second-order, else the seed's interface estimate) and the sign-change test;
+/// 4. the estimates written over the radial values; 5. band consistency check per slab;
+/// 6. (one item) the band and the far field; 7. assembly per slab.
+///
+/// Each phase reads only what earlier phases wrote, and every slab does the same arithmetic
+/// in either mode, so the grid does not depend on the thread count (tested).
+fn band_build(
     spec: &GridSpec,
     centre: &Point3<f64>,
     radii: Radii<'_>,
+    parallel: bool,
 ) -> Result<Vec<f64>> {
     let [nx, ny, nz] = spec.dims;
     let plane = nx * ny;
-    let (premade, calls, nodes) = match radii {
-        Radii::Map(map) => (Some(map), None, None),
-        Radii::Calls { face_cells, radius } => (None, Some((face_cells, radius)), None),
-        Radii::Nodes(g) => (None, None, Some(g)),
+    let (premade, calls, mut values) = match radii {
+        Radii::Map(map) => (Some(map), None, vec![FAR; spec.len()]),
+        Radii::Calls { face_cells, radius } => {
+            (None, Some((face_cells, radius)), vec![FAR; spec.len()])
+        }
+        // The exact table's radial values are the output grid's starting values.
+        Radii::Nodes(g) => (None, None, g),
     };
+    let exact = premade.is_none() && calls.is_none();
     let m = calls.map_or(0, |(n, _)| n + 1);
     // Phase outputs, each written once.
     let rows: Vec<OnceLock<Vec<f64>>> = (0..6 * m).map(|_| OnceLock::new()).collect();
@@ -588,34 +599,31 @@ fn band_build_parallel(
     if let Some(map) = premade {
         let _ = shell.set(Ok(Shell::new(spec, centre, map, Redistance::Band)));
     }
-    let radial: Vec<OnceLock<Vec<f64>>> = (0..nz).map(|_| OnceLock::new()).collect();
-    let found: Vec<OnceLock<Vec<(usize, f64)>>> = (0..nz).map(|_| OnceLock::new()).collect();
-    let field: OnceLock<Result<(Vec<f64>, Band, Coarse)>> = OnceLock::new();
+    let bands: Vec<OnceLock<SlabBand>> = (0..nz).map(|_| OnceLock::new()).collect();
+    let demoted: Vec<OnceLock<Vec<usize>>> = (0..nz).map(|_| OnceLock::new()).collect();
+    let crossed = AtomicBool::new(false);
+    let field: OnceLock<Result<(Band, Coarse)>> = OnceLock::new();
     let est = BandSlab::new(spec, centre);
-    let mut values = vec![0.0; spec.len()];
-    let out: Vec<Mutex<&mut [f64]>> = values.chunks_mut(plane).map(Mutex::new).collect();
-    let slab = |k: usize| -> Option<&[f64]> {
-        match &nodes {
-            Some(g) => Some(&g[plane * k..plane * (k + 1)]),
-            None => radial[k].get().map(Vec::as_slice),
-        }
-    };
+    let out: Vec<RwLock<&mut [f64]>> = values.chunks_mut(plane).map(RwLock::new).collect();
     let counts = [
         6 * m,
         usize::from(calls.is_some()),
-        if nodes.is_some() { 0 } else { nz },
-        nz - 2,
+        if exact { 0 } else { nz },
+        nz,
+        nz,
+        nz,
         1,
         nz,
     ];
-    crew::run_phases(&counts, &|phase, i| match phase {
+    let no_bits = vec![0u64; plane.div_ceil(64)];
+    let work = |phase: usize, k: usize| match phase {
         0 => {
             if let Some((n, radius)) = calls {
-                let (f, q) = (i / m, i % m);
+                let (f, q) = (k / m, k % m);
                 let row = (0..m)
                     .map(|p| radius(CubeMap::direction(n, f, p, q)))
                     .collect();
-                let _ = rows[i].set(row);
+                let _ = rows[k].set(row);
             }
         }
         1 => {
@@ -625,50 +633,103 @@ fn band_build_parallel(
             }
         }
         2 => {
-            if let Some(Ok(shell)) = shell.get() {
-                let mut v = vec![FAR; plane];
-                shell.fill(i, &mut v);
-                let _ = radial[i].set(v);
+            if let (Some(Ok(shell)), Ok(mut dst)) = (shell.get(), out[k].write()) {
+                shell.fill(k, &mut dst);
             }
         }
         3 => {
-            let k = i + 1;
-            if let (Some(lo), Some(mid), Some(up)) = (slab(k - 1), slab(k), slab(k + 1)) {
-                let mut f = Vec::new();
-                est.estimates(k, [lo, mid, up], &mut f);
-                let _ = found[k].set(f);
+            if !matches!(shell.get(), Some(Ok(_)) | None) {
+                // Invalid radii (reported from the shell).
+                return;
             }
+            let Ok(mid) = out[k].read() else { return };
+            let up = out.get(k + 1).and_then(|s| s.read().ok());
+            let mut found = Vec::new();
+            if k > 0
+                && let (Ok(lo), Some(up)) = (out[k - 1].read(), &up)
+            {
+                est.estimates(k, [&lo, &mid, up], &mut found);
+            }
+            // The sign-change test stops once one slab has found a change.
+            if !crossed.load(Ordering::Relaxed)
+                && slab_crosses(nx, &mid, up.as_deref().map(|u| &**u))
+            {
+                crossed.store(true, Ordering::Relaxed);
+            }
+            let mut bits = vec![0u64; plane.div_ceil(64)];
+            let mut inner = Vec::new();
+            for &(c, d) in &found {
+                bits[c / 64] |= 1 << (c % 64);
+                if d < 0.0 {
+                    inner.push(c);
+                }
+            }
+            let _ = bands[k].set(SlabBand { found, bits, inner });
         }
         4 => {
-            let mut g = Vec::with_capacity(spec.len());
-            for k in 0..nz {
-                match slab(k) {
-                    Some(s) => g.extend_from_slice(s),
-                    // The radii were invalid (reported from the shell slot).
-                    None => return,
+            if let (Some(b), Ok(mut dst)) = (bands[k].get(), out[k].write()) {
+                for &(c, d) in &b.found {
+                    dst[c] = d;
                 }
             }
-            let r = if crosses(spec, &g) {
-                let mut b = BandBuilder::new(g.len());
-                for f in &found[1..nz - 1] {
-                    if let Some(f) = f.get() {
-                        b.apply(f, &mut g);
-                    }
-                }
-                let band = b.finish(spec, &mut g);
-                Coarse::interior(spec, &g, &band).map(|c| (g, band, c))
-            } else {
-                Err(Error::NoSurface)
+        }
+        5 => {
+            let Some(b) = bands[k].get() else { return };
+            if b.inner.is_empty() {
+                let _ = demoted[k].set(Vec::new());
+                return;
+            }
+            // Band nodes are interior nodes: slabs k ± 1 exist.
+            let bits = |k: usize| bands[k].get().map_or(&no_bits[..], |b| &b.bits[..]);
+            let (Ok(gl), Ok(gm), Ok(gu)) = (out[k - 1].read(), out[k].read(), out[k + 1].read())
+            else {
+                return;
             };
-            let _ = field.set(r);
+            let d = consistency(
+                nx,
+                spec.spacing,
+                [&gl, &gm, &gu],
+                [bits(k - 1), &b.bits, bits(k + 1)],
+                &b.inner,
+            );
+            let _ = demoted[k].set(d);
+        }
+        6 => {
+            if !matches!(shell.get(), Some(Ok(_)) | None) {
+                return;
+            }
+            if !crossed.load(Ordering::Relaxed) {
+                let _ = field.set(Err(Error::NoSurface));
+                return;
+            }
+            let mut band = Band(vec![0; spec.len().div_ceil(64)]);
+            for (k, b) in bands.iter().enumerate() {
+                let Some(b) = b.get() else { return };
+                for &(c, _) in &b.found {
+                    band.set(plane * k + c, true);
+                }
+                for &c in demoted[k].get().map_or(&[][..], Vec::as_slice) {
+                    band.set(plane * k + c, false);
+                }
+            }
+            let guards: Vec<_> = out.iter().filter_map(|s| s.read().ok()).collect();
+            let slabs: Vec<&[f64]> = guards.iter().map(|g| &***g).collect();
+            if slabs.len() == nz {
+                let _ = field.set(Coarse::interior(spec, &slabs, &band).map(|c| (band, c)));
+            }
         }
         _ => {
-            if let (Some(Ok((g, band, coarse))), Ok(mut dst)) = (field.get(), out[i].lock()) {
-                dst.copy_from_slice(&g[plane * i..plane * (i + 1)]);
-                coarse.assemble_slab(spec, i, &mut dst, band);
+            if let (Some(Ok((band, coarse))), Ok(mut dst)) = (field.get(), out[k].write()) {
+                // Demoted band nodes lost their radial value; −∞ (sign only, no bound) keeps
+                // the suspect band value from clamping the far field that replaces it.
+                for &c in demoted[k].get().map_or(&[][..], Vec::as_slice) {
+                    dst[c] = f64::NEG_INFINITY;
+                }
+                coarse.assemble_slab(spec, k, &mut dst, band);
             }
         }
-    });
+    };
+    crew::run_phases(&counts, parallel, &work);
     drop(out);
     if let Some(Err(e)) = shell.into_inner() {
         return Err(e);
@@ -676,8 +737,65 @@ fn band_build_parallel(
     match field.into_inner() {
         Some(Ok(_)) => Ok(values),
         Some(Err(e)) => Err(e),
+        // Only after invalid radii, reported above.
         None => Err(Error::NoSurface),
     }
+}
+
+/// Whether the radial field changes sign between neighbouring nodes of slab `mid` (rows of
+/// `nx`) or between `mid` and the next slab `up`.
+fn slab_crosses(nx: usize, mid: &[f64], up: Option<&[f64]>) -> bool {
+    let neg = |v: f64| v < 0.0;
+    let within = mid
+        .chunks_exact(nx)
+        .any(|r| r.windows(2).any(|w| neg(w[0]) != neg(w[1])))
+        || mid.iter().zip(&mid[nx..]).any(|(&a, &b)| neg(a) != neg(b));
+    within || up.is_some_and(|up| mid.iter().zip(up).any(|(&a, &b)| neg(a) != neg(b)))
+}
+
+/// Consistency check of one slab's interior band nodes `inner` (in-slab indices; values
+/// and band bits of the slabs below, at and above): near a ridge of the distance (the medial
+/// axis, which reaches the surface at convex kinks of r), the expansion can err without its
+/// guards noticing; there the band values break |∇φ| = 1. A node whose six neighbours are
+/// interior band nodes and whose central-difference gradient norm is off by more than
+/// EIKONAL_SLACK leaves the band (one pass, on the values before the pass) and takes the far
+/// field. Nodes next to the surface stay (their far-field value would be poor); outside,
+/// the far field is only a bound, so exterior band values are kept. Returns the nodes that
+/// leave.
+fn consistency(
+    nx: usize,
+    h: f64,
+    [lo, mid, up]: [&[f64]; 3],
+    [blo, bmid, bup]: [&[u64]; 3],
+    inner: &[usize],
+) -> Vec<usize> {
+    let has = |b: &[u64], c: usize| b[c / 64] >> (c % 64) & 1 == 1;
+    let (lo2, hi2) = (
+        (1.0 - EIKONAL_SLACK).powi(2) * 4.0 * h * h,
+        (1.0 + EIKONAL_SLACK).powi(2) * 4.0 * h * h,
+    );
+    let sy = nx;
+    let mut demote = Vec::new();
+    for &c in inner {
+        let ok = [c - 1, c + 1, c - sy, c + sy]
+            .iter()
+            .all(|&q| has(bmid, q) && mid[q] < 0.0)
+            && has(blo, c)
+            && lo[c] < 0.0
+            && has(bup, c)
+            && up[c] < 0.0;
+        if !ok {
+            continue;
+        }
+        let gx = mid[c + 1] - mid[c - 1];
+        let gy = mid[c + sy] - mid[c - sy];
+        let gz = up[c] - lo[c];
+        let n2 = gx * gx + gy * gy + gz * gz;
+        if n2 > hi2 || n2 < lo2 {
+            demote.push(c);
+        }
+    }
+    demote
 }
 
 /// The nine grid rows around a row of nodes: `rows[z][y]` for the z-slabs k − 1, k, k + 1
@@ -767,6 +885,11 @@ fn interface_estimate(r: &Rows<'_>, i: usize, h: f64) -> Option<f64> {
         lo[1][i],
         up[1][i],
     ];
+    // Most callers have no neighbour of the other sign: a branch-free count first.
+    let negative: u32 = nb.iter().map(|&w| u32::from(w < 0.0)).sum();
+    if negative == if inside { 6 } else { 0 } {
+        return None;
+    }
     let mut cap = f64::INFINITY;
     for w in nb {
         if (w < 0.0) != inside {
@@ -808,28 +931,6 @@ impl Band {
     }
 }
 
-/// Whether some pair of neighbouring nodes differs in sign.
-fn crosses(spec: &GridSpec, g: &[f64]) -> bool {
-    let [nx, ny, nz] = spec.dims;
-    let (sy, sz) = (nx, nx * ny);
-    for k in 0..nz {
-        for j in 0..ny {
-            let row = sy * j + sz * k;
-            for i in 0..nx {
-                let c = row + i;
-                let inside = g[c] < 0.0;
-                if (i + 1 < nx && (g[c + 1] < 0.0) != inside)
-                    || (j + 1 < ny && (g[c + sy] < 0.0) != inside)
-                    || (k + 1 < nz && (g[c + sz] < 0.0) != inside)
-                {
-                    return true;
-                }
-            }
-        }
-    }
-    false
-}
-
 /// The band estimates of one z-slab (see [`Redistance::Band`]).
 struct BandSlab {
     dims: [usize; 3],
@@ -853,19 +954,22 @@ impl BandSlab {
     }
 
     /// Appends the band estimates of the interior slab k (`mid`, between `lo` and `up`, all
-    /// radial values) to `found`: (node index, value).
+    /// radial values) to `found`: (in-slab node index, value).
     fn estimates(&self, k: usize, [lo, mid, up]: [&[f64]; 3], found: &mut Vec<(usize, f64)>) {
         let [nx, ny, _] = self.dims;
         let (h, o, cut2, band_w) = (self.h, self.o, self.cut2, self.band_w);
-        let plane = nx * ny;
         let z = o.z + h * k as f64;
         for j in 1..ny - 1 {
             let row = nx * j;
             let y = o.y + h * j as f64;
             let yz2 = y * y + z * z;
             let r = rows([lo, mid, up], row, nx);
-            for (i, &v) in r[1][1].iter().enumerate().take(nx - 1).skip(1) {
+            let centre_row = r[1][1];
+            // An index loop: the stencil reads nine rows at i − 1, i, i + 1.
+            #[allow(clippy::needless_range_loop)]
+            for i in 1..nx - 1 {
                 let c = row + i;
+                let v = centre_row[i];
                 // Cheap screen first: the first-order estimate |g|/|∇g| with |∇g| ≤ 2
                 // must be below 1.15 band widths (a node needing a larger second-order
                 // correction takes the far field). The radial field is singular at the
@@ -880,7 +984,7 @@ impl BandSlab {
                     second_order_distance(&r, i, h, cut2)
                 };
                 if d.abs() < band_w {
-                    found.push((plane * k + c, d));
+                    found.push((c, d));
                 } else if let Some(e) = v
                     .is_finite()
                     .then(|| interface_estimate(&r, i, h))
@@ -888,105 +992,11 @@ impl BandSlab {
                 {
                     // A node next to the surface where the expansion is not trusted:
                     // the seed's first-order interface estimate.
-                    found.push((plane * k + c, e));
+                    found.push((c, e));
                 }
             }
         }
     }
-}
-
-/// Band membership under construction: estimates are written over the radial field slab by
-/// slab, in slab order.
-struct BandBuilder {
-    band: Band,
-    /// The interior band nodes, for the consistency check.
-    inner: Vec<usize>,
-}
-
-impl BandBuilder {
-    fn new(len: usize) -> Self {
-        Self {
-            band: Band(vec![0; len.div_ceil(64)]),
-            inner: Vec::new(),
-        }
-    }
-
-    fn apply(&mut self, found: &[(usize, f64)], g: &mut [f64]) {
-        for &(c, d) in found {
-            g[c] = d;
-            self.band.set(c, true);
-            if d < 0.0 {
-                self.inner.push(c);
-            }
-        }
-    }
-
-    /// Consistency check: near a ridge of the distance (the medial axis, which reaches the
-    /// surface at convex kinks of r), the expansion can err without its guards noticing;
-    /// there the band values break |∇φ| = 1. An interior band node whose six neighbours are
-    /// band nodes and whose central-difference gradient norm is off by more than
-    /// EIKONAL_SLACK leaves the band (one pass, on the values before the pass) and takes the
-    /// far field.
-    fn finish(self, spec: &GridSpec, g: &mut [f64]) -> Band {
-        let Self { mut band, inner } = self;
-        let [nx, ny, _] = spec.dims;
-        let h = spec.spacing;
-        let (sy, sz) = (nx, nx * ny);
-        let mut demote = Vec::new();
-        let (lo2, hi2) = (
-            (1.0 - EIKONAL_SLACK).powi(2) * 4.0 * h * h,
-            (1.0 + EIKONAL_SLACK).powi(2) * 4.0 * h * h,
-        );
-        // Outside, the far field is only a bound: exterior band values are kept. Band nodes
-        // are interior grid nodes, so their six neighbours exist.
-        for &c in &inner {
-            // Nodes next to the surface stay (their far-field value would be poor).
-            let nb = [c - 1, c + 1, c - sy, c + sy, c - sz, c + sz];
-            if !nb.iter().all(|&q| band.has(q) && g[q] < 0.0) {
-                continue;
-            }
-            let gx = g[c + 1] - g[c - 1];
-            let gy = g[c + sy] - g[c - sy];
-            let gz = g[c + sz] - g[c - sz];
-            let n2 = gx * gx + gy * gy + gz * gz;
-            if n2 > hi2 || n2 < lo2 {
-                demote.push(c);
-            }
-        }
-        for c in demote {
-            band.set(c, false);
-            // Its radial value is gone; −∞ (sign only, no bound) keeps the suspect band value
-            // from clamping the far field that replaces it.
-            g[c] = f64::NEG_INFINITY;
-        }
-        band
-    }
-}
-
-/// Writes the second-order distances of the band nodes over the radial field `g` (other
-/// nodes keep their radial value) and returns the band membership (sequential: the stencils
-/// read copies of the slabs below, which keep their radial values while slab k is
-/// overwritten).
-#[inline(never)]
-fn band_values(spec: &GridSpec, est: &BandSlab, g: &mut [f64]) -> Band {
-    let [nx, ny, nz] = spec.dims;
-    let plane = nx * ny;
-    let mut b = BandBuilder::new(g.len());
-    let mut lo = g[..plane].to_vec();
-    let mut mid = vec![0.0; plane];
-    let mut found = Vec::new();
-    for k in 1..nz - 1 {
-        mid.copy_from_slice(&g[plane * k..plane * (k + 1)]);
-        found.clear();
-        est.estimates(
-            k,
-            [&lo, &mid, &g[plane * (k + 1)..plane * (k + 2)]],
-            &mut found,
-        );
-        b.apply(&found, g);
-        std::mem::swap(&mut lo, &mut mid);
-    }
-    b.finish(spec, g)
 }
 
 /// Value of an exterior node outside the band: `min(|g|, BAND_CELLS·h)`, the band width
@@ -1014,7 +1024,7 @@ impl Coarse {
     /// closest surface point is `x − d·∇g/|∇g|`, to every interior coarse node; exterior
     /// coarse nodes outside the band take [`exterior_value`].
     #[inline(never)]
-    fn interior(spec: &GridSpec, g: &[f64], band: &Band) -> Result<Self> {
+    fn interior(spec: &GridSpec, slabs: &[&[f64]], band: &Band) -> Result<Self> {
         let [nx, ny, nz] = spec.dims;
         let h = spec.spacing;
         let (sy, sz) = (nx, nx * ny);
@@ -1044,8 +1054,10 @@ impl Coarse {
                     let p = (ic + 1) + px * (jc + 1) + pz * (kc + 1);
                     // Nodes beyond the grid take the sign of the last grid node.
                     let (i, j, k) = (2 * ic, 2 * jc, 2 * kc);
-                    let c = i.min(nx - 1) + sy * j.min(ny - 1) + sz * k.min(nz - 1);
-                    let d = g[c];
+                    let (ks, cs) = (k.min(nz - 1), i.min(nx - 1) + sy * j.min(ny - 1));
+                    let c = cs + sz * ks;
+                    let g = slabs[ks];
+                    let d = g[cs];
                     let inside = d < 0.0;
                     // A source: a band node within SOURCE_CELLS·h whose six neighbours are band
                     // nodes (band nodes are interior nodes, so they exist), the normal being
@@ -1060,9 +1072,9 @@ impl Coarse {
                             .all(|&q| band.has(q));
                     if source {
                         let grad = Vector3::new(
-                            (g[c + 1] - g[c - 1]) * inv2h,
-                            (g[c + sy] - g[c - sy]) * inv2h,
-                            (g[c + sz] - g[c - sz]) * inv2h,
+                            (g[cs + 1] - g[cs - 1]) * inv2h,
+                            (g[cs + sy] - g[cs - sy]) * inv2h,
+                            (slabs[ks + 1][cs] - slabs[ks - 1][cs]) * inv2h,
                         );
                         let x = spec.node(i, j, k).coords - grad * (d / grad.norm());
                         (cx[p], cy[p], cz[p]) = (x.x as f32, x.y as f32, x.z as f32);
@@ -1074,7 +1086,7 @@ impl Coarse {
                         r.0 = r.0.min(ic);
                         r.1 = r.1.max(ic + 1);
                     } else {
-                        dist[p] = exterior_value(g[c], band_w);
+                        dist[p] = exterior_value(d, band_w);
                     }
                 }
             }
@@ -1153,18 +1165,9 @@ impl Coarse {
         Ok(Self { m, ax })
     }
 
-    /// Fine values, written over `g`: trusted band values; elsewhere inside, the trilinear
-    /// interpolation of the coarse values (separably: x, then y, then z); elsewhere outside,
-    /// [`exterior_value`].
-    #[inline(never)]
-    fn assemble(&self, spec: &GridSpec, g: &mut [f64], band: &Band, parallel: bool) {
-        let plane = spec.dims[0] * spec.dims[1];
-        for_each_slab(g, plane, parallel, |k, slab| {
-            self.assemble_slab(spec, k, slab, band);
-        });
-    }
-
-    /// [`Coarse::assemble`] of z-slab `k`.
+    /// Fine values of z-slab `k`, written over its band values: trusted band values;
+    /// elsewhere inside, the trilinear interpolation of the coarse values (separably: x,
+    /// then y, then z); elsewhere outside, [`exterior_value`].
     fn assemble_slab(&self, spec: &GridSpec, k: usize, slab: &mut [f64], band: &Band) {
         let [nx, ny, _] = spec.dims;
         let h = spec.spacing;
