@@ -155,13 +155,29 @@ fn sweep(seed: u64) -> Vec<Config> {
             },
         });
     }
-    for (tol, rt) in [(0.02, 0.03), (0.03, 0.03)] {
+    for (tol, rt, rep) in [
+        (0.02, 0.03, 0),
+        (0.03, 0.03, 0),
+        (0.03, 0.03, 1),
+        (0.03, 0.03, 2),
+        (0.03, 0.03, 4),
+    ] {
+        let repairs = if rep > 0 {
+            format!("-rep{rep}")
+        } else {
+            String::new()
+        };
         out.push(Config {
-            name: format!("m28x18-b50-ls45-tol{:.0}-rq{:.0}", 100.0 * tol, 100.0 * rt),
+            name: format!(
+                "m28x18-b50-ls45-tol{:.0}-rq{:.0}{repairs}",
+                100.0 * tol,
+                100.0 * rt
+            ),
             trial: None,
             params: Params {
                 tolerance: tol,
                 roundness_tolerance: Some(rt),
+                roundness_repairs: rep,
                 seed,
                 ..Params::default()
             },

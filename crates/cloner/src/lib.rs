@@ -40,7 +40,8 @@
 //!   not favour easy targets; a candidate rounder than its target is sharpened
 //!   (inverse Laplacian steps) instead of rejected; an optional level-set
 //!   roundness check (`Params::roundness_tolerance`) removes the residual
-//!   scatter of the surface roundness.
+//!   scatter of the surface roundness, and re-steered repairs
+//!   (`Params::roundness_repairs`) rescue the candidates it would reject.
 //! * **Seed methods kept.** [`Params::seed_faithful`] selects the seed's
 //!   pairwise-PDF targets, neighbourhood-averaged radii, bilinear
 //!   interpolation and untouched embryo axes, for comparison.

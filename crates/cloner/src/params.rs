@@ -131,6 +131,13 @@ pub struct Params {
     /// Largest |measured − target| roundness of an accepted clone, checked on
     /// its level set (`None` = the surface-DNA steering alone, the default).
     pub roundness_tolerance: Option<f64>,
+    /// With `roundness_tolerance`: re-steered polishing passes of a candidate
+    /// whose measured roundness misses (the same raw field polished again
+    /// toward a surface roundness moved against the miss, then quality
+    /// control and a new level set) before it is rejected (0 = reject at the
+    /// first miss).
+    #[serde(default)]
+    pub roundness_repairs: usize,
     /// Radii fields tried for one draw of the targets before the targets are
     /// redrawn (1 = the seed: a rejected grain is discarded whole).
     pub fields_per_target: usize,
@@ -157,6 +164,7 @@ impl Default for Params {
             axis_corrections: 2,
             pilot_clones: 96,
             roundness_tolerance: None,
+            roundness_repairs: 0,
             fields_per_target: 64,
             max_attempts: 20_000,
             seed: 2018,
@@ -268,6 +276,13 @@ impl Params {
             && !(t.is_finite() && t > 0.0 && t < 1.0)
         {
             return bad("roundness_tolerance", t, "in (0, 1)");
+        }
+        if self.roundness_repairs > 16 {
+            return bad(
+                "roundness_repairs",
+                self.roundness_repairs as f64,
+                "at most 16",
+            );
         }
         if self.fields_per_target == 0 {
             return bad("fields_per_target", 0.0, "at least 1");

@@ -448,3 +448,52 @@ fn the_level_set_roundness_check_holds_for_every_clone() {
         })
     ));
 }
+
+#[test]
+fn roundness_repairs_keep_the_check_and_save_candidates() {
+    let base = Params {
+        roundness_tolerance: Some(0.02),
+        ..small_params()
+    };
+    let without = CloneModel::fit(parents(), &base).expect("model");
+    let with = CloneModel::fit(
+        parents(),
+        &Params {
+            roundness_repairs: 2,
+            ..base
+        },
+    )
+    .expect("model");
+    let a = without.run(0..6, Hooks::default()).expect("run");
+    let b = in_pool(1, || with.run(0..6, Hooks::default()).expect("run"));
+    let b2 = in_pool(2, || with.run(0..6, Hooks::default()).expect("run"));
+    // deterministic for any thread count
+    assert_eq!(b.clones, b2.clones);
+    assert_eq!(b.stats, b2.stats);
+    // every clone still passes the level-set check
+    for c in &b.clones {
+        let measured = c.dna.as_ref().expect("dna")[2];
+        assert!((measured - c.targets.roundness).abs() <= 0.02);
+    }
+    // repairs were tried, and they cut the measured-roundness rejections
+    assert!(b.stats.roundness_repairs > 0);
+    assert!(
+        b.stats.rejections.measured_roundness < a.stats.rejections.measured_roundness,
+        "{} vs {}",
+        b.stats.rejections.measured_roundness,
+        a.stats.rejections.measured_roundness
+    );
+    assert!(matches!(
+        CloneModel::fit(
+            parents(),
+            &Params {
+                roundness_repairs: 17,
+                ..base
+            }
+        ),
+        Err(Error::InvalidParameter {
+            name: "roundness_repairs",
+            ..
+        })
+    ));
+}
