@@ -119,4 +119,4 @@ pub use pipeline::{
     Clock, ClonedGrain, Hooks, NoClock, Progress, Rejections, Run, RunStats, StageTimes, clone_rng,
     shard_range,
 };
-pub use surface::{Interpolation, MeshGeometry, SurfaceDna};
+pub use surface::{DirectionPlan, Interpolation, MeshGeometry, SurfaceDna};

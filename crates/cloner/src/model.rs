@@ -3,7 +3,7 @@
 //! spherical mesh, the surface DNA of those profiles, the target sampler and
 //! the radii sampler.
 
-use levelset::Grid;
+use levelset::{DirectionTable, Grid, StarParams};
 use morph_dna::{
     AcceptanceRejection2d, BicubicPdf, Descriptor, DnaTable, GaussianCopula, Histogram1d,
     Histogram2d, InverseCdfSampler1d, MeasureParams, PrincipalFrame, measure_with_frame,
@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::params::{Params, RadiiModel, TargetModel};
-use crate::surface::{MeshGeometry, SurfaceDna};
+use crate::surface::{DirectionPlan, MeshGeometry, SurfaceDna};
 
 /// The DNA measured on every parent and on every clone, in this order:
 /// aspect ratio, grain (equivalent) diameter, roundness, volume/surface
@@ -287,6 +287,10 @@ pub struct CloneModel {
     measured_targets: TargetSampler,
     radii: RadiiSampler,
     pub(crate) map: SteeringMap,
+    /// The radius function's plans at the directions of the level-set builder's cube map
+    /// (`levelset::cube_map_directions`): a clone's table is a sparse product, not 6534
+    /// calls with trigonometry.
+    pub(crate) cube: Vec<DirectionPlan>,
 }
 
 /// Which target distribution a candidate draws from.
@@ -529,8 +533,15 @@ impl CloneModel {
                 }
             }
         };
+        let face_cells = match StarParams::default().table {
+            DirectionTable::CubeMap { face_cells } => face_cells,
+            DirectionTable::Exact => 32,
+        };
+        let dirs = levelset::cube_map_directions(face_cells).map_err(Error::from)?;
+        let cube = geom.plans(&dirs, params.interpolation);
         let mut model = Self {
             params: *params,
+            cube,
             geom,
             surface,
             profiles,

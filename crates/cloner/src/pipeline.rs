@@ -615,12 +615,11 @@ impl CloneModel {
         let r_max = radii.iter().fold(0.0f64, |a, b| a.max(*b));
         let half = self.params.grid_margin * r_max;
         let spec = GridSpec::cube(resolution, -half, half)?;
-        let (grid, _) = Grid::from_star(
-            spec,
-            &Point3::origin(),
-            self.geom.radius_fn(radii, self.params.interpolation),
-            &StarParams::default(),
-        )?;
+        // the cube-map table by the precomputed plans: the radius function's values at
+        // the table's directions, bit for bit (tested)
+        let table: Vec<f64> = self.cube.iter().map(|p| self.geom.eval(p, radii)).collect();
+        let (grid, _) =
+            Grid::from_star_table(spec, &Point3::origin(), &table, &StarParams::default())?;
         Ok(grid)
     }
 

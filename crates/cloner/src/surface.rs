@@ -410,22 +410,62 @@ impl MeshGeometry {
 
     /// Interpolated radius in direction `(θ, φ)` of the mesh frame.
     pub fn interpolate(&self, r: &[f64], theta: f64, phi: f64, how: Interpolation) -> f64 {
+        self.eval(&self.plan(theta, phi, how), r)
+    }
+
+    /// How [`MeshGeometry::interpolate`] combines the node radii in direction `(θ, φ)`
+    /// (the interpolation is linear in the radii): node indices and weights, for
+    /// [`MeshGeometry::eval`] at many fields.
+    pub fn plan(&self, theta: f64, phi: f64, how: Interpolation) -> DirectionPlan {
         let n_pol = self.mesh.n_pol;
         let t = (theta / self.dtheta).clamp(0.0, (n_pol + 1) as f64);
         let j0 = (t.floor() as usize).min(n_pol);
         let ft = t - j0 as f64;
         let phi = phi.rem_euclid(TAU);
-        match how {
+        let mut rows = [RowPlan::Node(0); 4];
+        let w = match how {
             Interpolation::Bilinear => {
-                let a = self.row_linear(r, j0 as isize, phi);
-                let b = self.row_linear(r, j0 as isize + 1, phi);
-                a + ft * (b - a)
+                rows[0] = self.row_linear(j0 as isize, phi);
+                rows[1] = self.row_linear(j0 as isize + 1, phi);
+                [ft, 0.0, 0.0, 0.0]
             }
             Interpolation::CatmullRom => {
-                let w = catmull_rom_weights(ft);
+                for (k, row) in rows.iter_mut().enumerate() {
+                    *row = self.row_cubic(j0 as isize - 1 + k as isize, phi);
+                }
+                catmull_rom_weights(ft)
+            }
+        };
+        DirectionPlan { how, w, rows }
+    }
+
+    /// The radius of field `r` by a plan of [`MeshGeometry::plan`]: the arithmetic of
+    /// [`MeshGeometry::interpolate`], so the same value bit for bit.
+    #[inline]
+    pub fn eval(&self, plan: &DirectionPlan, r: &[f64]) -> f64 {
+        let row = |p: &RowPlan| match *p {
+            RowPlan::Node(i) => r[i as usize],
+            RowPlan::Linear(i, j, f) => {
+                let (a, b) = (r[i as usize], r[j as usize]);
+                a + f * (b - a)
+            }
+            RowPlan::Cubic(idx, w) => {
                 let mut s = 0.0;
-                for (k, wk) in w.iter().enumerate() {
-                    s += wk * self.row_cubic(r, j0 as isize - 1 + k as isize, phi);
+                for (wk, &i) in w.iter().zip(&idx) {
+                    s += wk * r[i as usize];
+                }
+                s
+            }
+        };
+        match plan.how {
+            Interpolation::Bilinear => {
+                let (a, b) = (row(&plan.rows[0]), row(&plan.rows[1]));
+                a + plan.w[0] * (b - a)
+            }
+            Interpolation::CatmullRom => {
+                let mut s = 0.0;
+                for (wk, p) in plan.w.iter().zip(&plan.rows) {
+                    s += wk * row(p);
                 }
                 s
             }
@@ -444,42 +484,43 @@ impl MeshGeometry {
         }
     }
 
-    fn ring_value(&self, r: &[f64], j: usize, i: isize) -> f64 {
+    /// Index of node `i` of ring `j` (the poles for j = 0 and j > n_pol).
+    fn ring_index(&self, j: usize, i: isize) -> u32 {
         let n_az = self.mesh.n_az;
-        if j == 0 {
-            r[0]
+        let k = if j == 0 {
+            0
         } else if j > self.mesh.n_pol {
-            r[r.len() - 1]
+            self.dirs.len() - 1
         } else {
-            r[1 + (j - 1) * n_az + i.rem_euclid(n_az as isize) as usize]
-        }
+            1 + (j - 1) * n_az + i.rem_euclid(n_az as isize) as usize
+        };
+        // meshes are far below 2³² nodes (validated)
+        u32::try_from(k).unwrap_or(u32::MAX)
     }
 
-    fn row_linear(&self, r: &[f64], j: isize, phi: f64) -> f64 {
+    fn row_linear(&self, j: isize, phi: f64) -> RowPlan {
         let (j, phi) = self.reflect(j, phi);
         let p = phi.rem_euclid(TAU) / self.dphi;
         let i0 = p.floor();
         let fp = p - i0;
         let i0 = i0 as isize;
-        let a = self.ring_value(r, j, i0);
-        let b = self.ring_value(r, j, i0 + 1);
-        a + fp * (b - a)
+        RowPlan::Linear(self.ring_index(j, i0), self.ring_index(j, i0 + 1), fp)
     }
 
-    fn row_cubic(&self, r: &[f64], j: isize, phi: f64) -> f64 {
+    fn row_cubic(&self, j: isize, phi: f64) -> RowPlan {
         let (j, phi) = self.reflect(j, phi);
         if j == 0 || j > self.mesh.n_pol {
-            return self.ring_value(r, j, 0);
+            return RowPlan::Node(self.ring_index(j, 0));
         }
         let p = phi.rem_euclid(TAU) / self.dphi;
         let i0 = p.floor();
         let w = catmull_rom_weights(p - i0);
         let i0 = i0 as isize;
-        let mut s = 0.0;
-        for (k, wk) in w.iter().enumerate() {
-            s += wk * self.ring_value(r, j, i0 - 1 + k as isize);
+        let mut idx = [0u32; 4];
+        for (k, x) in idx.iter_mut().enumerate() {
+            *x = self.ring_index(j, i0 - 1 + k as isize);
         }
-        s
+        RowPlan::Cubic(idx, w)
     }
 
     /// The radius function of the field for `levelset::Grid::from_star`
@@ -490,11 +531,54 @@ impl MeshGeometry {
         how: Interpolation,
     ) -> impl FnMut(Unit<Vector3<f64>>) -> f64 + 'a {
         move |u: Unit<Vector3<f64>>| {
-            let theta = u.z.clamp(-1.0, 1.0).acos();
-            let phi = u.y.atan2(u.x);
+            let (theta, phi) = angles(&u);
             self.interpolate(r, theta, phi, how)
         }
     }
+
+    /// The plans of [`MeshGeometry::radius_fn`] at `directions` (a cube map's, for
+    /// `levelset::Grid::from_star_table`): `eval` of plan `t` at a field is the radius
+    /// function in direction `t`, bit for bit.
+    pub fn plans(
+        &self,
+        directions: &[Unit<Vector3<f64>>],
+        how: Interpolation,
+    ) -> Vec<DirectionPlan> {
+        directions
+            .iter()
+            .map(|u| {
+                let (theta, phi) = angles(u);
+                self.plan(theta, phi, how)
+            })
+            .collect()
+    }
+}
+
+/// One θ-row of a [`DirectionPlan`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum RowPlan {
+    /// A pole's radius.
+    Node(u32),
+    /// Two azimuthal taps `a + f·(b − a)` (bilinear).
+    Linear(u32, u32, f64),
+    /// Four azimuthal Catmull-Rom taps.
+    Cubic([u32; 4], [f64; 4]),
+}
+
+/// The node indices and weights of [`MeshGeometry::interpolate`] in one direction
+/// ([`MeshGeometry::plan`], [`MeshGeometry::eval`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DirectionPlan {
+    how: Interpolation,
+    /// θ weights (Catmull-Rom), or `[ft, …]` (bilinear).
+    w: [f64; 4],
+    rows: [RowPlan; 4],
+}
+
+/// Polar and azimuthal angles of a unit direction.
+#[inline]
+fn angles(u: &Unit<Vector3<f64>>) -> (f64, f64) {
+    (u.z.clamp(-1.0, 1.0).acos(), u.y.atan2(u.x))
 }
 
 /// Catmull-Rom weights of the four taps `−1, 0, 1, 2` at `t ∈ [0, 1]`.

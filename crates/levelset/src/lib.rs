@@ -88,4 +88,6 @@ pub use grid::{Grid, GridSpec};
 pub use mesh::{MeshDistance, TriMesh};
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
-pub use star::{BAND_CELLS, DirectionTable, Redistance, StarBuild, StarParams};
+pub use star::{
+    BAND_CELLS, DirectionTable, Redistance, StarBuild, StarParams, cube_map_directions,
+};

@@ -143,6 +143,31 @@ impl StarParams {
     }
 }
 
+/// The directions of the cube-map table with `face_cells` cells per face edge, in table order
+/// (face `f = 2·axis + (negative ? 1 : 0)`, then rows, then columns): where
+/// [`Grid::from_star`] calls the radius function, and the order of the radii of
+/// [`Grid::from_star_table`].
+///
+/// # Errors
+/// [`Error::InvalidParameter`] if `face_cells` is not between 2 and 4096.
+pub fn cube_map_directions(face_cells: usize) -> Result<Vec<Unit<Vector3<f64>>>> {
+    StarParams {
+        table: DirectionTable::CubeMap { face_cells },
+        ..StarParams::default()
+    }
+    .validate()?;
+    let m = face_cells + 1;
+    let mut out = Vec::with_capacity(6 * m * m);
+    for f in 0..6 {
+        for q in 0..m {
+            for p in 0..m {
+                out.push(CubeMap::direction(face_cells, f, p, q));
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// Marker for "far from the interface, distance unknown" before sweeping.
 const FAR: f64 = f64::INFINITY;
 
@@ -300,6 +325,45 @@ impl Grid {
             }
         };
         star_grid(spec, centre, radii, params)
+    }
+
+    /// [`Grid::from_star`] from the radii of the cube map given directly: `radii[t]` is the
+    /// radius in direction `cube_map_directions(face_cells)[t]`, with `params.table =
+    /// DirectionTable::CubeMap { face_cells }` (the same grid, bit for bit, as
+    /// [`Grid::from_star`] with a function returning those values). For callers that can
+    /// tabulate their surface at fixed directions faster than by one call per direction
+    /// (the cloner precomputes its interpolation weights once per mesh).
+    ///
+    /// # Errors
+    /// As [`Grid::from_star`]; [`Error::InvalidParameter`] if the table is not a cube map or
+    /// `radii` has not `6·(face_cells + 1)²` entries.
+    pub fn from_star_table(
+        spec: GridSpec,
+        centre: &Point3<f64>,
+        radii: &[f64],
+        params: &StarParams,
+    ) -> Result<(Self, StarBuild)> {
+        check_star(&spec, centre, params)?;
+        let DirectionTable::CubeMap { face_cells } = params.table else {
+            return Err(Error::InvalidParameter {
+                name: "table",
+                value: f64::NAN,
+                requirement: "a cube map (the radii are given at its directions)",
+            });
+        };
+        let m = face_cells + 1;
+        if radii.len() != 6 * m * m {
+            return Err(Error::InvalidParameter {
+                name: "radii",
+                value: radii.len() as f64,
+                requirement: "6·(face_cells + 1)² values, one per cube-map direction",
+            });
+        }
+        let mut next = radii.iter();
+        let map = CubeMap::build(face_cells, &mut |_| {
+            next.next().copied().unwrap_or(f64::NAN)
+        })?;
+        star_grid(spec, centre, Radii::Map(map), params)
     }
 
     /// [`Grid::from_star`] for a radius function that can be shared between threads: with
@@ -1394,6 +1458,52 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_tabulated_cube_map_gives_the_function_build() {
+        let lumpy = |u: Unit<Vector3<f64>>| {
+            0.7 + 0.15 * (3.0 * u.z).sin() * (2.0 * u.x).cos() + 0.05 * (5.0 * u.y).sin()
+        };
+        let spec = GridSpec::cube(30, -1.2, 1.2).expect("spec");
+        let c = Point3::new(0.05, -0.03, 0.02);
+        for face_cells in [8, 32] {
+            let p = StarParams {
+                table: DirectionTable::CubeMap { face_cells },
+                ..StarParams::default()
+            };
+            let dirs = cube_map_directions(face_cells).expect("dirs");
+            let radii: Vec<f64> = dirs.iter().map(|&u| lumpy(u)).collect();
+            let (a, ab) = Grid::from_star(spec, &c, lumpy, &p).expect("a");
+            let (b, bb) = Grid::from_star_table(spec, &c, &radii, &p).expect("b");
+            assert_eq!(ab, bb);
+            assert!(
+                a.values()
+                    .iter()
+                    .zip(b.values())
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+            );
+            // wrong length, wrong table, an invalid radius
+            let e = Grid::from_star_table(spec, &c, &radii[1..], &p);
+            assert!(matches!(
+                e,
+                Err(Error::InvalidParameter { name: "radii", .. })
+            ));
+            let exact = StarParams {
+                table: DirectionTable::Exact,
+                ..p
+            };
+            let e = Grid::from_star_table(spec, &c, &radii, &exact);
+            assert!(matches!(
+                e,
+                Err(Error::InvalidParameter { name: "table", .. })
+            ));
+            let mut bad = radii.clone();
+            bad[5] = -1.0;
+            let e = Grid::from_star_table(spec, &c, &bad, &p);
+            assert!(matches!(e, Err(Error::InvalidRadius { .. })));
+        }
+        assert!(cube_map_directions(1).is_err());
     }
 
     #[test]

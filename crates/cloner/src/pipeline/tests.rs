@@ -11,6 +11,7 @@ use proptest::prelude::*;
 use super::*;
 use crate::output::{Format, write_grid};
 use crate::params::{Outputs, Params, RadiiModel, TargetModel};
+use crate::surface::Interpolation;
 use crate::{Error, Parents};
 
 /// A bumpy ellipsoid: semi-axes and bump phases vary with `k`.
@@ -496,4 +497,38 @@ fn roundness_repairs_keep_the_check_and_save_candidates() {
             ..
         })
     ));
+}
+
+#[test]
+fn the_tabulated_rasterisation_is_the_radius_function_build() {
+    for how in [Interpolation::CatmullRom, Interpolation::Bilinear] {
+        let m = CloneModel::fit(
+            parents(),
+            &Params {
+                interpolation: how,
+                pilot_clones: 0,
+                ..small_params()
+            },
+        )
+        .expect("model");
+        let c = m.clone_one(3, &NoClock).expect("clone").0;
+        let fast = m.rasterise(&c.radii).expect("table build");
+        let r_max = c.radii.iter().fold(0.0f64, |a, b| a.max(*b));
+        let half = m.params().grid_margin * r_max;
+        let spec = GridSpec::cube(m.params().level_set_resolution, -half, half).expect("spec");
+        let (slow, _) = Grid::from_star(
+            spec,
+            &Point3::origin(),
+            m.geometry().radius_fn(&c.radii, how),
+            &StarParams::default(),
+        )
+        .expect("function build");
+        assert!(
+            fast.values()
+                .iter()
+                .zip(slow.values())
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "{how:?}"
+        );
+    }
 }
