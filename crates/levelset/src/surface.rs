@@ -326,6 +326,8 @@ struct MeshSink {
     ny: usize,
     /// Per layer parity, per node of the layer, per direction: vertex index + 1 (0 = none).
     cache: Vec<u32>,
+    /// Per slot of `cache`: the entries written since it was last cleared.
+    written: [Vec<usize>; 2],
     vertices: Vec<Point3<f64>>,
     triangles: Vec<[usize; 3]>,
 }
@@ -334,10 +336,13 @@ impl Sink for MeshSink {
     type V = usize;
 
     fn begin_layer(&mut self, k: usize) {
-        // Layer k + 1 reuses the slot of layer k − 1: clear it.
-        let layer = self.nx * self.ny * 8;
+        // Layer k + 1 reuses the slot of layer k − 1: clear the entries it wrote (a few
+        // hundred, against 8·nx·ny for the whole slot).
         let slot = (k + 1) & 1;
-        self.cache[slot * layer..(slot + 1) * layer].fill(0);
+        for &idx in &self.written[slot] {
+            self.cache[idx] = 0;
+        }
+        self.written[slot].clear();
     }
 
     fn vertex(&mut self, i: usize, j: usize, k: usize, dir: u8, p: Point3<f64>) -> usize {
@@ -350,6 +355,7 @@ impl Sink for MeshSink {
         self.vertices.push(p);
         let n = self.vertices.len();
         self.cache[idx] = u32::try_from(n).unwrap_or(u32::MAX);
+        self.written[k & 1].push(idx);
         n - 1
     }
 
@@ -378,6 +384,7 @@ impl Grid {
                 nx: spec.dims[0],
                 ny: spec.dims[1],
                 cache: vec![0; 2 * spec.dims[0] * spec.dims[1] * 8],
+                written: [Vec::new(), Vec::new()],
                 vertices: Vec::with_capacity(10 * crossings + 16),
                 triangles: Vec::with_capacity(20 * crossings + 16),
             };

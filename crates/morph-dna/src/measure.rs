@@ -226,7 +226,9 @@ fn hessian_cell(spec: &GridSpec, p: &Point3<f64>) -> ([usize; 3], [f64; 3]) {
     for a in 0..3 {
         let n = spec.dims[a];
         let x = rel[a].clamp(0.0, (n - 1) as f64);
-        let i = (x.floor() as usize).min(n - 2);
+        // x ≥ 0 (or NaN, which casts to 0 as its floor does): truncation is the floor,
+        // without the libm call of `f64::floor`
+        let i = (x as usize).min(n - 2);
         c[a] = i;
         t[a] = x - i as f64;
     }
