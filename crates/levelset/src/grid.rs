@@ -472,6 +472,16 @@ pub(crate) const CORNERS: [[usize; 3]; 8] = [
     [1, 1, 1],
 ];
 
+/// `x.floor()` for the cell search of [`Grid::locate`]: truncation, one down for negative
+/// non-integers (exact below 2⁵³; beyond, `x` is an integer or the i64 cast saturates, and the
+/// caller's clamp gives the same cell; NaN gives 0, which the clamp and the NaN local
+/// coordinate make equivalent).
+#[inline]
+fn floor(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t > x { t - 1.0 } else { t }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -574,14 +584,4 @@ mod tests {
         assert!(g.is_inside(&Point3::new(0.0, 0.0, 0.0)));
         assert!(!g.is_inside(&Point3::new(0.5, 0.0, 0.0)));
     }
-}
-
-/// `x.floor()` for the cell search of [`Grid::locate`]: truncation, one down for negative
-/// non-integers (exact below 2⁵³; beyond, `x` is an integer or the i64 cast saturates, and the
-/// caller's clamp gives the same cell; NaN gives 0, which the clamp and the NaN local
-/// coordinate make equivalent).
-#[inline]
-fn floor(x: f64) -> f64 {
-    let t = x as i64 as f64;
-    if t > x { t - 1.0 } else { t }
 }

@@ -92,12 +92,16 @@ fn corner_vec(c: u8) -> Vector3<f64> {
     )
 }
 
-/// Triangles of one tetrahedron: list of (edges as corner pairs), oriented. Precomputed
-/// for all 16 sign patterns of each of the 6 tetrahedra.
+/// Triangles of the cube's sign patterns, assembled from those of the six tetrahedra
+/// (oriented edge lists for all 16 sign patterns of each, built first).
 struct TetTable {
-    /// For (tet, mask): up to two triangles, each three edges (corner a, corner b), with a
-    /// count.
-    tris: [[([[u8; 2]; 3], bool); 2]; 96],
+    /// For every sign pattern of the cube (256): its triangles as edge slots
+    /// ([`EDGE_SLOT`]), in the order of the tetrahedra and of `tris` (the order the walk
+    /// emits them), `cube[cube_off[m]..cube_off[m + 1]]`.
+    cube: Vec<[u8; 3]>,
+    cube_off: [u16; 257],
+    /// Corners `(lo, hi)` of every edge slot.
+    ends: [(u8, u8); 19],
 }
 
 fn build_table() -> TetTable {
@@ -146,7 +150,43 @@ fn build_table() -> TetTable {
             }
         }
     }
-    TetTable { tris }
+    let mut ends = [(0u8, 0u8); 19];
+    for lo in 0u8..8 {
+        for hi in lo + 1..8 {
+            let k = EDGE_SLOT[usize::from(lo) * 8 + usize::from(hi)];
+            if k != u8::MAX {
+                ends[usize::from(k)] = (lo, hi);
+            }
+        }
+    }
+    let mut cube = Vec::new();
+    let mut cube_off = [0u16; 257];
+    for cmask in 0usize..256 {
+        for (t, tet) in TETS.iter().enumerate() {
+            let mut m = 0usize;
+            for (v, &c) in tet.iter().enumerate() {
+                m |= ((cmask >> c) & 1) << v;
+            }
+            if m == 0 || m == 15 {
+                continue;
+            }
+            for &(tri, used) in &tris[t * 16 + m] {
+                if used {
+                    cube.push(tri.map(|[a, b]| {
+                        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                        EDGE_SLOT[usize::from(lo) * 8 + usize::from(hi)]
+                    }));
+                }
+            }
+        }
+        // at most 12 triangles per cube: 256·12 fits u16
+        cube_off[cmask + 1] = u16::try_from(cube.len()).unwrap_or(u16::MAX);
+    }
+    TetTable {
+        cube,
+        cube_off,
+        ends,
+    }
 }
 
 fn table() -> &'static TetTable {
@@ -171,9 +211,12 @@ pub(crate) fn walk<S: Sink>(spec: &GridSpec, values: &[f64], sink: &mut S) {
     // word operations and only cells with mixed corner signs are visited.
     let words = nx.div_ceil(64);
     let mut bits = vec![0u64; words * ny * nz];
-    for (r, row) in values.chunks_exact(nx).enumerate() {
-        for (i, &v) in row.iter().enumerate() {
-            bits[r * words + i / 64] |= u64::from(v < 0.0) << (i % 64);
+    for (out, row) in bits.chunks_exact_mut(words).zip(values.chunks_exact(nx)) {
+        for (w, chunk) in out.iter_mut().zip(row.chunks(64)) {
+            *w = chunk
+                .iter()
+                .enumerate()
+                .fold(0u64, |a, (i, &v)| a | (u64::from(v < 0.0) << i));
         }
     }
     let mut any = vec![0u64; words];
@@ -226,54 +269,44 @@ pub(crate) fn walk<S: Sink>(spec: &GridSpec, values: &[f64], sink: &mut S) {
                     sink.cell(i, j, k);
                     let base = spec.node(i, j, k);
                     let mut cache: [Option<S::V>; 19] = [None; 19];
-                    for (t, tet) in TETS.iter().enumerate() {
-                        let mut m = 0usize;
-                        for (v, &c) in tet.iter().enumerate() {
-                            m |= usize::from((cmask >> c) & 1) << v;
+                    let span = usize::from(tab.cube_off[usize::from(cmask)])
+                        ..usize::from(tab.cube_off[usize::from(cmask) + 1]);
+                    for tri in &tab.cube[span] {
+                        let mut handles = [None; 3];
+                        for (slot, &key) in tri.iter().enumerate() {
+                            let key = usize::from(key);
+                            let hnd = match cache[key] {
+                                Some(v) => v,
+                                None => {
+                                    let (lo, hi) = tab.ends[key];
+                                    let fa = if phi[lo as usize] < 0.0 {
+                                        phi[lo as usize]
+                                    } else {
+                                        phi[lo as usize].max(delta)
+                                    };
+                                    let fb = if phi[hi as usize] < 0.0 {
+                                        phi[hi as usize]
+                                    } else {
+                                        phi[hi as usize].max(delta)
+                                    };
+                                    let tpar = fa / (fa - fb);
+                                    let d = hi ^ lo;
+                                    let p = base + h * (corner_vec(lo) + tpar * corner_vec(d));
+                                    let v = sink.vertex(
+                                        i + (lo & 1) as usize,
+                                        j + ((lo >> 1) & 1) as usize,
+                                        k + ((lo >> 2) & 1) as usize,
+                                        d,
+                                        p,
+                                    );
+                                    cache[key] = Some(v);
+                                    v
+                                }
+                            };
+                            handles[slot] = Some(hnd);
                         }
-                        if m == 0 || m == 15 {
-                            continue;
-                        }
-                        for &(tri, used) in &tab.tris[t * 16 + m] {
-                            if !used {
-                                continue;
-                            }
-                            let mut handles = [None; 3];
-                            for (slot, &[a, bb]) in tri.iter().enumerate() {
-                                let (lo, hi) = if a < bb { (a, bb) } else { (bb, a) };
-                                let key = EDGE_SLOT[(lo as usize) * 8 + hi as usize] as usize;
-                                let hnd = match cache[key] {
-                                    Some(v) => v,
-                                    None => {
-                                        let fa = if phi[lo as usize] < 0.0 {
-                                            phi[lo as usize]
-                                        } else {
-                                            phi[lo as usize].max(delta)
-                                        };
-                                        let fb = if phi[hi as usize] < 0.0 {
-                                            phi[hi as usize]
-                                        } else {
-                                            phi[hi as usize].max(delta)
-                                        };
-                                        let tpar = fa / (fa - fb);
-                                        let d = hi ^ lo;
-                                        let p = base + h * (corner_vec(lo) + tpar * corner_vec(d));
-                                        let v = sink.vertex(
-                                            i + (lo & 1) as usize,
-                                            j + ((lo >> 1) & 1) as usize,
-                                            k + ((lo >> 2) & 1) as usize,
-                                            d,
-                                            p,
-                                        );
-                                        cache[key] = Some(v);
-                                        v
-                                    }
-                                };
-                                handles[slot] = Some(hnd);
-                            }
-                            if let [Some(x), Some(y), Some(z)] = handles {
-                                sink.triangle([x, y, z]);
-                            }
+                        if let [Some(x), Some(y), Some(z)] = handles {
+                            sink.triangle([x, y, z]);
                         }
                     }
                 }
