@@ -36,9 +36,8 @@
 //! [`StarParams::parallel`] the phases run on the rayon pool in one cooperative pass (the
 //! internal `crew` scheduler: one pool wake-up per build instead of one per parallel pass,
 //! which on a 2-vCPU virtual machine cost 80–135 µs each); [`Grid::from_star_sync`] also
-//! spreads the
-//! radius calls of the cube map. Only the table's validation and the far-field sweeps stay
-//! sequential. Every slab does the same arithmetic in either mode, so the grids are
+//! spreads the radius calls of the cube map. Only the table's validation and the far-field
+//! sweeps stay sequential. Every slab does the same arithmetic in either mode, so the grids are
 //! bit-identical for any thread count (tested with 1, 2, 3 and 7 threads).
 
 use nalgebra::{Point3, Unit, Vector3};
