@@ -289,15 +289,16 @@ fn max_principal_curvatures(grid: &Grid, points: &[Point3<f64>]) -> Vec<Option<f
     // (xx, xy, xz, yy, yz, zz) and the central-difference gradient
     let mut slot = vec![u32::MAX; grid.values().len()];
     let mut nodal: Vec<[f64; 9]> = Vec::with_capacity(points.len());
-    let mut node = |i: usize, j: usize, k: usize| -> [f64; 9] {
+    // index into `nodal` of node (i, j, k), computed on first use
+    let mut node = |nodal: &mut Vec<[f64; 9]>, i: usize, j: usize, k: usize| -> usize {
         let id = i + nx * (j + ny * k);
         let s = slot[id];
         if s != u32::MAX {
-            return nodal[s as usize];
+            return s as usize;
         }
         let m = node_hessian(grid, i, j, k);
         let g = grid.node_gradient(i, j, k);
-        let v = [
+        nodal.push([
             m[(0, 0)],
             m[(0, 1)],
             m[(0, 2)],
@@ -307,10 +308,9 @@ fn max_principal_curvatures(grid: &Grid, points: &[Point3<f64>]) -> Vec<Option<f
             g.x,
             g.y,
             g.z,
-        ];
-        slot[id] = u32::try_from(nodal.len()).unwrap_or(u32::MAX);
-        nodal.push(v);
-        v
+        ]);
+        slot[id] = u32::try_from(nodal.len() - 1).unwrap_or(u32::MAX);
+        nodal.len() - 1
     };
     points
         .iter()
@@ -318,6 +318,7 @@ fn max_principal_curvatures(grid: &Grid, points: &[Point3<f64>]) -> Vec<Option<f
             let ([i, j, k], [tx, ty, tz]) = hessian_cell(spec, p);
             // 6 Hessian entries and the gradient, accumulated entry by entry
             // in the order of `max_principal_curvature` and `Grid::gradient`
+            // (the cached entries read in place)
             let mut acc = [0.0f64; 9];
             // `Grid::gradient` locates the same cell with the same weights
             // ((wx·wy)·wz, all ≥ 0) for every point, inside the box or not:
@@ -328,8 +329,8 @@ fn max_principal_curvatures(grid: &Grid, points: &[Point3<f64>]) -> Vec<Option<f
                     for (di, wx) in [(0, 1.0 - tx), (1, tx)] {
                         let w = wx * wy * wz;
                         if w > 0.0 {
-                            let e = node(i + di, j + dj, k + dk);
-                            for (s, v) in acc.iter_mut().zip(e) {
+                            let e = node(&mut nodal, i + di, j + dj, k + dk);
+                            for (s, v) in acc.iter_mut().zip(&nodal[e]) {
                                 *s += w * v;
                             }
                         }
