@@ -229,21 +229,35 @@ impl CubeMap {
     }
 
     /// The table from its face rows (row `f·m + q` holds the nodes p = 0..m of face f, row
-    /// q), validated in table order.
+    /// q), validated in table order; a missing row (only after a panic elsewhere) reads as
+    /// invalid radii.
     fn from_rows(n: usize, rows: &[OnceLock<Vec<f64>>]) -> Result<Self> {
         let m = n + 1;
-        let mut radii = Vec::with_capacity(6 * m * m);
-        for (row, slot) in rows.iter().enumerate() {
-            let (f, q) = (row / m, row % m);
-            let vals = slot.get().map_or(&[][..], Vec::as_slice);
-            for p in 0..m {
-                // A missing row (only after a panic elsewhere) reads as an invalid radius.
-                let v = vals.get(p).copied().unwrap_or(f64::NAN);
-                if !(v.is_finite() && v > 0.0) {
-                    checked_radius(Self::direction(n, f, p, q), v)?;
-                }
-                radii.push(v as f32);
+        Self::from_values(
+            n,
+            rows.iter().flat_map(|slot| {
+                let vals = slot.get().map_or(&[][..], Vec::as_slice);
+                (0..m).map(move |p| vals.get(p).copied().unwrap_or(f64::NAN))
+            }),
+        )
+    }
+
+    /// The table from its values in table order, validated in that order (a direction is
+    /// computed only to report an invalid radius); missing values read as invalid.
+    fn from_values(n: usize, values: impl Iterator<Item = f64>) -> Result<Self> {
+        let m = n + 1;
+        let len = 6 * m * m;
+        let mut radii = Vec::with_capacity(len);
+        for (t, v) in values
+            .chain(std::iter::repeat(f64::NAN))
+            .take(len)
+            .enumerate()
+        {
+            if !(v.is_finite() && v > 0.0) {
+                let (f, q, p) = (t / (m * m), t / m % m, t % m);
+                checked_radius(Self::direction(n, f, p, q), v)?;
             }
+            radii.push(v as f32);
         }
         Ok(Self { n, radii })
     }
@@ -359,10 +373,7 @@ impl Grid {
                 requirement: "6·(face_cells + 1)² values, one per cube-map direction",
             });
         }
-        let mut next = radii.iter();
-        let map = CubeMap::build(face_cells, &mut |_| {
-            next.next().copied().unwrap_or(f64::NAN)
-        })?;
+        let map = CubeMap::from_values(face_cells, radii.iter().copied())?;
         star_grid(spec, centre, Radii::Map(map), params)
     }
 
@@ -391,16 +402,21 @@ impl Grid {
             },
             DirectionTable::Exact => {
                 let plane = spec.dims[0] * spec.dims[1];
-                let mut rs = vec![0.0; spec.len()];
-                rs.par_chunks_mut(plane).enumerate().for_each(|(k, slab)| {
-                    for (i, r) in slab.iter_mut().enumerate() {
-                        *r = radius(node_ray(&spec, centre, plane * k + i).1);
+                // (ρ, r) per node on the pool; validated in node order (the direction is
+                // recomputed only to report an invalid radius)
+                let mut rr = vec![(0.0, 0.0); spec.len()];
+                rr.par_chunks_mut(plane).enumerate().for_each(|(k, slab)| {
+                    for (i, v) in slab.iter_mut().enumerate() {
+                        let (rho, u) = node_ray(&spec, centre, plane * k + i);
+                        *v = (rho, radius(u));
                     }
                 });
-                let mut g = rs;
-                for (c, v) in g.iter_mut().enumerate() {
-                    let (rho, u) = node_ray(&spec, centre, c);
-                    *v = rho - checked_radius(u, *v)?;
+                let mut g = Vec::with_capacity(rr.len());
+                for (c, &(rho, r)) in rr.iter().enumerate() {
+                    if !(r.is_finite() && r > 0.0) {
+                        checked_radius(node_ray(&spec, centre, c).1, r)?;
+                    }
+                    g.push(rho - r);
                 }
                 Radii::Nodes(g)
             }
@@ -568,16 +584,16 @@ fn star_grid(
         Redistance::FullSweep => {
             // Far nodes hold ±∞ until the sweeps (which reach every node) give them a
             // distance; `Grid::new` re-checks that everything ended finite.
-            let mut values = match radii {
-                Radii::Nodes(g) => g,
-                Radii::Map(_) | Radii::Calls { .. } => {
-                    let map = match radii {
-                        Radii::Calls { face_cells, radius } => {
-                            CubeMap::build_parallel(face_cells, radius)?
-                        }
-                        Radii::Map(map) => map,
-                        Radii::Nodes(_) => unreachable!("matched above"),
-                    };
+            let map = match radii {
+                Radii::Nodes(g) => Err(g),
+                Radii::Map(map) => Ok(map),
+                Radii::Calls { face_cells, radius } => {
+                    Ok(CubeMap::build_parallel(face_cells, radius)?)
+                }
+            };
+            let mut values = match map {
+                Err(g) => g,
+                Ok(map) => {
                     let shell = Shell::new(&spec, centre, map, params.redistance);
                     let mut values = vec![FAR; spec.len()];
                     for_each_slab(&mut values, plane, params.parallel, |k, s| {
