@@ -226,9 +226,10 @@ fn hessian_cell(spec: &GridSpec, p: &Point3<f64>) -> ([usize; 3], [f64; 3]) {
     for a in 0..3 {
         let n = spec.dims[a];
         let x = rel[a].clamp(0.0, (n - 1) as f64);
-        // x ≥ 0 (or NaN, which casts to 0 as its floor does): truncation is the floor,
-        // without the libm call of `f64::floor`
-        let i = (x as usize).min(n - 2);
+        // x ∈ [0, n − 1] (or NaN, which casts to 0 as its floor does):
+        // truncation is the floor, without the libm call of `f64::floor`,
+        // and the signed conversion is exact and cheaper than the unsigned one
+        let i = (x as i64 as usize).min(n - 2);
         c[a] = i;
         t[a] = x - i as f64;
     }
@@ -285,64 +286,70 @@ pub fn max_principal_curvature(grid: &Grid, p: &Point3<f64>) -> Option<f64> {
 fn max_principal_curvatures(grid: &Grid, points: &[Point3<f64>]) -> Vec<Option<f64>> {
     let spec = grid.spec();
     let [nx, ny, _] = spec.dims;
+    let nxy = nx * ny;
+    // node offsets of cell corner c = di + 2·dj + 4·dk, the order of
+    // `max_principal_curvature` (i fastest)
+    let offsets = [0, 1, nx, nx + 1, nxy, nxy + 1, nxy + nx, nxy + nx + 1];
     // per node: slot into `nodal`, which holds the 6 Hessian entries
     // (xx, xy, xz, yy, yz, zz) and the central-difference gradient
     let mut slot = vec![u32::MAX; grid.values().len()];
     let mut nodal: Vec<[f64; 9]> = Vec::with_capacity(points.len());
-    // index into `nodal` of node (i, j, k), computed on first use
-    let mut node = |nodal: &mut Vec<[f64; 9]>, i: usize, j: usize, k: usize| -> usize {
-        let id = i + nx * (j + ny * k);
-        let s = slot[id];
-        if s != u32::MAX {
-            return s as usize;
-        }
-        let m = node_hessian(grid, i, j, k);
-        let g = grid.node_gradient(i, j, k);
-        nodal.push([
-            m[(0, 0)],
-            m[(0, 1)],
-            m[(0, 2)],
-            m[(1, 1)],
-            m[(1, 2)],
-            m[(2, 2)],
-            g.x,
-            g.y,
-            g.z,
-        ]);
-        slot[id] = u32::try_from(nodal.len() - 1).unwrap_or(u32::MAX);
-        nodal.len() - 1
-    };
-    points
-        .iter()
-        .map(|p| {
-            let ([i, j, k], [tx, ty, tz]) = hessian_cell(spec, p);
-            // 6 Hessian entries and the gradient, accumulated entry by entry
-            // in the order of `max_principal_curvature` and `Grid::gradient`
-            // (the cached entries read in place)
-            let mut acc = [0.0f64; 9];
-            // `Grid::gradient` locates the same cell with the same weights
-            // ((wx·wy)·wz, all ≥ 0) for every point, inside the box or not:
-            // its base index is clamped to [0, n − 2] and its offsets to
-            // [0, 1], as `hessian_cell` clamps the point to the box
-            for (dk, wz) in [(0, 1.0 - tz), (1, tz)] {
-                for (dj, wy) in [(0, 1.0 - ty), (1, ty)] {
-                    for (di, wx) in [(0, 1.0 - tx), (1, tx)] {
-                        let w = wx * wy * wz;
-                        if w > 0.0 {
-                            let e = node(&mut nodal, i + di, j + dj, k + dk);
-                            for (s, v) in acc.iter_mut().zip(&nodal[e]) {
-                                *s += w * v;
-                            }
-                        }
-                    }
+    let mut out = Vec::with_capacity(points.len());
+    for p in points {
+        let ([i, j, k], [tx, ty, tz]) = hessian_cell(spec, p);
+        let (wx, wy, wz) = ([1.0 - tx, tx], [1.0 - ty, ty], [1.0 - tz, tz]);
+        let base = i + nx * (j + ny * k);
+        // 6 Hessian entries and the gradient, accumulated entry by entry
+        // in the order of `max_principal_curvature` and `Grid::gradient`
+        // (the cached entries read in place); `Grid::gradient` locates the
+        // same cell with the same weights ((wx·wy)·wz, all ≥ 0) for every
+        // point, inside the box or not: its base index is clamped to
+        // [0, n − 2] and its offsets to [0, 1], as `hessian_cell` clamps the
+        // point to the box
+        let ws = [
+            wx[0] * wy[0] * wz[0],
+            wx[1] * wy[0] * wz[0],
+            wx[0] * wy[1] * wz[0],
+            wx[1] * wy[1] * wz[0],
+            wx[0] * wy[0] * wz[1],
+            wx[1] * wy[0] * wz[1],
+            wx[0] * wy[1] * wz[1],
+            wx[1] * wy[1] * wz[1],
+        ];
+        let mut acc = [0.0f64; 9];
+        for (c, (&w, off)) in ws.iter().zip(&offsets).enumerate() {
+            if w > 0.0 {
+                let (di, dj, dk) = (c & 1, (c >> 1) & 1, c >> 2);
+                let id = base + off;
+                let mut s = slot[id];
+                if s == u32::MAX {
+                    let m = node_hessian(grid, i + di, j + dj, k + dk);
+                    let g = grid.node_gradient(i + di, j + dj, k + dk);
+                    s = u32::try_from(nodal.len()).unwrap_or(u32::MAX);
+                    nodal.push([
+                        m[(0, 0)],
+                        m[(0, 1)],
+                        m[(0, 2)],
+                        m[(1, 1)],
+                        m[(1, 2)],
+                        m[(2, 2)],
+                        g.x,
+                        g.y,
+                        g.z,
+                    ]);
+                    slot[id] = s;
+                }
+                for (a, v) in acc.iter_mut().zip(&nodal[s as usize]) {
+                    *a += w * v;
                 }
             }
-            let hess = Matrix3::new(
-                acc[0], acc[1], acc[2], acc[1], acc[3], acc[4], acc[2], acc[4], acc[5],
-            );
-            curvature_from(&hess, &Vector3::new(acc[6], acc[7], acc[8]))
-        })
-        .collect()
+        }
+        let hess = Matrix3::new(
+            acc[0], acc[1], acc[2], acc[1], acc[3], acc[4], acc[2], acc[4], acc[5],
+        );
+        out.push(curvature_from(&hess, &Vector3::new(acc[6], acc[7], acc[8])));
+    }
+    out
 }
 
 /// Full axes `[L, I, S]` of the inertia-equivalent ellipsoid with the given
