@@ -198,20 +198,20 @@ fn node_hessian(grid: &Grid, i: usize, j: usize, k: usize) -> Matrix3<f64> {
     let h2 = grid.spacing() * grid.spacing();
     // clamp to the interior so that every ±1 neighbour exists
     let (i, j, k) = (i.clamp(1, nx - 2), j.clamp(1, ny - 2), k.clamp(1, nz - 2));
-    let f = |di: isize, dj: isize, dk: isize| {
-        grid.at(
-            i.wrapping_add_signed(di),
-            j.wrapping_add_signed(dj),
-            k.wrapping_add_signed(dk),
-        )
-    };
-    let c = f(0, 0, 0);
-    let xx = (f(1, 0, 0) - 2.0 * c + f(-1, 0, 0)) / h2;
-    let yy = (f(0, 1, 0) - 2.0 * c + f(0, -1, 0)) / h2;
-    let zz = (f(0, 0, 1) - 2.0 * c + f(0, 0, -1)) / h2;
-    let xy = (f(1, 1, 0) - f(1, -1, 0) - f(-1, 1, 0) + f(-1, -1, 0)) / (4.0 * h2);
-    let xz = (f(1, 0, 1) - f(1, 0, -1) - f(-1, 0, 1) + f(-1, 0, -1)) / (4.0 * h2);
-    let yz = (f(0, 1, 1) - f(0, 1, -1) - f(0, -1, 1) + f(0, -1, -1)) / (4.0 * h2);
+    let (sy, sz) = (nx, nx * ny);
+    let c0 = i + nx * (j + ny * k);
+    // the 3×3×3 block around the node, as one slice (no per-read bounds check)
+    let v = &grid.values()[c0 - 1 - sy - sz..=c0 + 1 + sy + sz];
+    let m = 1 + sy + sz;
+    let f = |d: isize| v[m.wrapping_add_signed(d)];
+    let (x, y, z) = (1isize, sy as isize, sz as isize);
+    let c = f(0);
+    let xx = (f(x) - 2.0 * c + f(-x)) / h2;
+    let yy = (f(y) - 2.0 * c + f(-y)) / h2;
+    let zz = (f(z) - 2.0 * c + f(-z)) / h2;
+    let xy = (f(x + y) - f(x - y) - f(-x + y) + f(-x - y)) / (4.0 * h2);
+    let xz = (f(x + z) - f(x - z) - f(-x + z) + f(-x - z)) / (4.0 * h2);
+    let yz = (f(y + z) - f(y - z) - f(-y + z) + f(-y - z)) / (4.0 * h2);
     Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz)
 }
 
