@@ -158,23 +158,31 @@ fn sweep(seed: u64) -> Vec<Config> {
     // the level-set roundness check with and without re-steered repairs, and looser V/S
     // quality controls once the check holds the roundness (the V/S QC rejects most
     // candidates; the jointly drawn, steered targets keep V/S on target without it)
-    for (tol, rt, rep) in [
-        (0.02, 0.03, 0),
-        (0.03, 0.03, 0),
-        (0.03, 0.03, 1),
-        (0.03, 0.03, 2),
-        (0.06, 0.03, 1),
-        (0.10, 0.03, 1),
-        (0.15, 0.03, 1),
+    // (and with predicted-roundness passes before the level set, which save level sets)
+    for (tol, rt, rep, pred) in [
+        (0.02, 0.03, 0, 0),
+        (0.03, 0.03, 0, 0),
+        (0.03, 0.03, 1, 0),
+        (0.03, 0.03, 2, 0),
+        (0.06, 0.03, 1, 0),
+        (0.10, 0.03, 1, 0),
+        (0.15, 0.03, 1, 0),
+        (0.10, 0.03, 1, 2),
+        (0.15, 0.03, 1, 2),
     ] {
         let repairs = if rep > 0 {
             format!("-rep{rep}")
         } else {
             String::new()
         };
+        let predictions = if pred > 0 {
+            format!("-pred{pred}")
+        } else {
+            String::new()
+        };
         out.push(Config {
             name: format!(
-                "m28x18-b50-ls45-tol{:.0}-rq{:.0}{repairs}",
+                "m28x18-b50-ls45-tol{:.0}-rq{:.0}{repairs}{predictions}",
                 100.0 * tol,
                 100.0 * rt
             ),
@@ -183,6 +191,7 @@ fn sweep(seed: u64) -> Vec<Config> {
                 tolerance: tol,
                 roundness_tolerance: Some(rt),
                 roundness_repairs: rep,
+                roundness_predictions: pred,
                 seed,
                 ..Params::default()
             },
@@ -417,7 +426,7 @@ fn report_md(
     let ms = |ns: u64| ns as f64 * 1e-6 / st.accepted.max(1) as f64;
     let _ = writeln!(
         md,
-        "Candidates: {} for {} clones (acceptance {:.1} %); rejected: {} too round (after sharpening), {} roundness not reached, {} V/S quality control, {} measured roundness, {} degenerate, {} target unavailable. Polishing steps per candidate: {:.1}; re-steered roundness repairs: {}.\n\nStage time per accepted clone (ms): targets {:.3}, radii {:.3}, polishing {:.3}, quality control {:.3}, rasterisation {:.3}, DNA {:.3}.\n",
+        "Candidates: {} for {} clones (acceptance {:.1} %); rejected: {} too round (after sharpening), {} roundness not reached, {} V/S quality control, {} measured roundness, {} degenerate, {} target unavailable. Polishing steps per candidate: {:.1}; re-steered roundness repairs: {}; predicted-roundness passes: {}.\n\nStage time per accepted clone (ms): targets {:.3}, radii {:.3}, polishing {:.3}, quality control {:.3}, rasterisation {:.3}, DNA {:.3}.\n",
         st.attempts,
         st.accepted,
         100.0 * st.acceptance_rate(),
@@ -429,6 +438,7 @@ fn report_md(
         r.target_unavailable,
         st.polishing_steps as f64 / st.attempts.max(1) as f64,
         st.roundness_repairs,
+        st.roundness_predictions,
         ms(st.times.targets_ns),
         ms(st.times.radii_ns),
         ms(st.times.polishing_ns),
@@ -457,6 +467,13 @@ fn report_md(
         m.slope[4],
         m.residual_sd[4],
     );
+    if let Some(c) = m.roundness_prediction {
+        let _ = writeln!(
+            md,
+            "Roundness prediction (same pilot clones, used by predicted-roundness passes): R ≈ {:+.3} + {:.3}·R_surface {:+.3}·r_ins/r_min (residual {:.4}; the affine map's, capped at tolerance/√3: {:.4}).\n",
+            c[0], c[1], c[2], m.roundness_prediction_sd, m.residual_sd[3],
+        );
+    }
     md.push_str("Plots: `histogram_<parameter>.svg` (chosen configuration), `grading.svg`, `error_vs_time.svg`.\n");
     Ok(md)
 }

@@ -41,7 +41,10 @@
 //!   (inverse Laplacian steps) instead of rejected; an optional level-set
 //!   roundness check (`Params::roundness_tolerance`) removes the residual
 //!   scatter of the surface roundness, and re-steered repairs
-//!   (`Params::roundness_repairs`) rescue the candidates it would reject.
+//!   (`Params::roundness_repairs`) rescue the candidates it would reject;
+//!   predicted-roundness passes (`Params::roundness_predictions`) re-steer
+//!   before the level set is built, from a pilot-fitted prediction that adds
+//!   the estimated inscribed radius to the surface roundness.
 //! * **Seed methods kept.** [`Params::seed_faithful`] selects the seed's
 //!   pairwise-PDF targets, neighbourhood-averaged radii, bilinear
 //!   interpolation and untouched embryo axes, for comparison.

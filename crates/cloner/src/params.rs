@@ -138,6 +138,15 @@ pub struct Params {
     /// first miss).
     #[serde(default)]
     pub roundness_repairs: usize,
+    /// With `roundness_tolerance`: re-steered polishing passes *before* the
+    /// level set is built, while the predicted level-set roundness misses the
+    /// target by more than half the tolerance. The prediction
+    /// ([`crate::SteeringMap::roundness_prediction`], fitted on the pilot
+    /// clones) adds the estimated inscribed radius over `r_min` to the surface
+    /// roundness; a pass costs a polish and the surface DNA, far less than a
+    /// level set and its roundness (0 = no prediction, the default).
+    #[serde(default)]
+    pub roundness_predictions: usize,
     /// Radii fields tried for one draw of the targets before the targets are
     /// redrawn (1 = the seed: a rejected grain is discarded whole).
     pub fields_per_target: usize,
@@ -165,6 +174,7 @@ impl Default for Params {
             pilot_clones: 96,
             roundness_tolerance: None,
             roundness_repairs: 0,
+            roundness_predictions: 0,
             fields_per_target: 64,
             max_attempts: 20_000,
             seed: 2018,
@@ -281,6 +291,13 @@ impl Params {
             return bad(
                 "roundness_repairs",
                 self.roundness_repairs as f64,
+                "at most 16",
+            );
+        }
+        if self.roundness_predictions > 16 {
+            return bad(
+                "roundness_predictions",
+                self.roundness_predictions as f64,
                 "at most 16",
             );
         }

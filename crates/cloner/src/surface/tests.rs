@@ -169,3 +169,32 @@ fn the_moments_only_path_equals_the_full_one() {
     assert_eq!(full.dims, fast.dims);
     assert!(fast.roundness.is_nan() && full.roundness > 0.0);
 }
+
+/// The inscribed-radius estimate: a sphere's radius (centred or not, the
+/// search finds it), an ellipsoid's smallest semi-axis (the largest
+/// inscribed sphere of an ellipsoid), within the node spacing; bad fields
+/// are `None`.
+#[test]
+fn inscribed_radius_of_spheres_and_ellipsoids() {
+    let g = geom(28, 18);
+    let sphere = vec![2.0; g.n_nodes()];
+    assert_relative_eq!(g.inscribed_radius(&sphere).expect("r"), 2.0, max_relative = 1e-9);
+    let e = ellipsoid_field(&g, [3.0, 2.0, 1.0]);
+    let r = g.inscribed_radius(&e).expect("r");
+    assert!((r - 1.0).abs() < 0.02, "{r}");
+    // an off-centre sphere, seen from the origin (centre at 0.3 along x)
+    let off: Vec<f64> = g
+        .dirs
+        .iter()
+        .map(|u| {
+            let b = 0.3 * u.x;
+            b + (b * b - (0.09 - 1.0)).sqrt()
+        })
+        .collect();
+    let r = g.inscribed_radius(&off).expect("r");
+    assert!((r - 1.0).abs() < 0.01, "{r}");
+    let mut bad = sphere.clone();
+    bad[3] = f64::NAN;
+    assert!(g.inscribed_radius(&bad).is_none());
+    assert!(g.inscribed_radius(&sphere[1..]).is_none());
+}
