@@ -140,13 +140,19 @@ pub struct Params {
     pub roundness_repairs: usize,
     /// With `roundness_tolerance`: re-steered polishing passes *before* the
     /// level set is built, while the predicted level-set roundness misses the
-    /// target by more than half the tolerance. The prediction
+    /// target by more than `roundness_prediction_margin` × the tolerance. The prediction
     /// ([`crate::SteeringMap::roundness_prediction`], fitted on the pilot
     /// clones) adds the estimated inscribed radius over `r_min` to the surface
     /// roundness; a pass costs a polish and the surface DNA, far less than a
     /// level set and its roundness (0 = no prediction, the default).
     #[serde(default)]
     pub roundness_predictions: usize,
+    /// The predicted miss, as a fraction of `roundness_tolerance`, above which
+    /// a predicted-roundness pass runs (in (0, 2]; default 0.5). Smaller
+    /// values save more level sets; larger ones leave alone the candidates
+    /// likely to pass, so the prediction's own bias moves fewer clones.
+    #[serde(default = "default_prediction_margin")]
+    pub roundness_prediction_margin: f64,
     /// Radii fields tried for one draw of the targets before the targets are
     /// redrawn (1 = the seed: a rejected grain is discarded whole).
     pub fields_per_target: usize,
@@ -156,6 +162,10 @@ pub struct Params {
     pub seed: u64,
     /// Outputs to produce.
     pub outputs: Outputs,
+}
+
+fn default_prediction_margin() -> f64 {
+    0.5
 }
 
 impl Default for Params {
@@ -175,6 +185,7 @@ impl Default for Params {
             roundness_tolerance: None,
             roundness_repairs: 0,
             roundness_predictions: 0,
+            roundness_prediction_margin: default_prediction_margin(),
             fields_per_target: 64,
             max_attempts: 20_000,
             seed: 2018,
@@ -292,6 +303,13 @@ impl Params {
                 "roundness_repairs",
                 self.roundness_repairs as f64,
                 "at most 16",
+            );
+        }
+        if !(self.roundness_prediction_margin > 0.0 && self.roundness_prediction_margin <= 2.0) {
+            return bad(
+                "roundness_prediction_margin",
+                self.roundness_prediction_margin,
+                "in (0, 2]",
             );
         }
         if self.roundness_predictions > 16 {

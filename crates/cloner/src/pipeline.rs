@@ -44,7 +44,7 @@
 //!    same way *before* stage 5 while the level-set roundness predicted from
 //!    its surface ([`crate::SteeringMap::roundness_prediction`]: the surface
 //!    roundness and the estimated inscribed radius over `r_min`) misses by
-//!    more than half the tolerance: a pass costs a polish and the surface
+//!    more than `roundness_prediction_margin` × the tolerance: a pass costs a polish and the surface
 //!    DNA instead of a level set and its roundness (calibration: repairs
 //!    208 → 87 per 500 clones, 18 % less CPU per clone).
 //!
@@ -228,6 +228,10 @@ pub struct RunStats {
     /// level set (`Params::roundness_predictions`).
     #[serde(default)]
     pub roundness_predictions: u64,
+    /// Level sets rasterised (first passes and repairs): the dominant cost
+    /// of a run, independent of the machine.
+    #[serde(default)]
+    pub level_sets: u64,
     /// Stage times.
     pub times: StageTimes,
 }
@@ -249,6 +253,7 @@ impl RunStats {
         self.polishing_steps += o.polishing_steps;
         self.roundness_repairs += o.roundness_repairs;
         self.roundness_predictions += o.roundness_predictions;
+        self.level_sets += o.level_sets;
         self.times.add(&o.times);
     }
 }
@@ -685,7 +690,8 @@ impl CloneModel {
             };
             let measure_dna = outputs.dna || check_roundness.is_some();
             // predicted-roundness passes: re-steer before any level set while
-            // the prediction misses by more than half the tolerance
+            // the prediction misses by more than the margin (a fraction of the
+            // tolerance)
             if let (Some(t), Some(pred)) = (check_roundness, self.map.roundness_prediction) {
                 for _ in 0..self.params.roundness_predictions {
                     let t0 = clock.now_ns();
@@ -697,7 +703,8 @@ impl CloneModel {
                         + pred[2] * ins / cand.surface.r_min;
                     let miss = predicted - cand.targets.roundness;
                     // (a NaN miss ends the passes too)
-                    if miss.abs().partial_cmp(&(0.5 * t)) != Some(std::cmp::Ordering::Greater) {
+                    let margin = self.params.roundness_prediction_margin * t;
+                    if miss.abs().partial_cmp(&margin) != Some(std::cmp::Ordering::Greater) {
                         break;
                     }
                     stats.roundness_predictions += 1;
@@ -720,6 +727,7 @@ impl CloneModel {
                     let g = self.rasterise(&cand.radii);
                     let t1 = clock.now_ns();
                     stats.times.rasterise_ns += t1 - t0;
+                    stats.level_sets += 1;
                     let Ok(g) = g else {
                         break Err(Reject::Degenerate);
                     };

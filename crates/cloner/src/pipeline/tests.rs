@@ -548,6 +548,21 @@ fn roundness_predictions_keep_the_check_and_determinism() {
             ..
         })
     ));
+    for margin in [0.0, -0.5, 2.5, f64::NAN] {
+        assert!(matches!(
+            CloneModel::fit(
+                parents(),
+                &Params {
+                    roundness_prediction_margin: margin,
+                    ..base
+                }
+            ),
+            Err(Error::InvalidParameter {
+                name: "roundness_prediction_margin",
+                ..
+            })
+        ));
+    }
 }
 
 #[test]
