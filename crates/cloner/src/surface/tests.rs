@@ -178,7 +178,11 @@ fn the_moments_only_path_equals_the_full_one() {
 fn inscribed_radius_of_spheres_and_ellipsoids() {
     let g = geom(28, 18);
     let sphere = vec![2.0; g.n_nodes()];
-    assert_relative_eq!(g.inscribed_radius(&sphere).expect("r"), 2.0, max_relative = 1e-9);
+    assert_relative_eq!(
+        g.inscribed_radius(&sphere).expect("r"),
+        2.0,
+        max_relative = 1e-9
+    );
     let e = ellipsoid_field(&g, [3.0, 2.0, 1.0]);
     let r = g.inscribed_radius(&e).expect("r");
     assert!((r - 1.0).abs() < 0.02, "{r}");
