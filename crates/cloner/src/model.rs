@@ -616,7 +616,7 @@ impl CloneModel {
     /// on surface DNA per target descriptor.
     fn fit_steering_map(&self, parent_mean: [f64; 5], parent_sd: [f64; 5]) -> Result<SteeringMap> {
         let k = self.params.pilot_clones as u64;
-        let pairs: Vec<Result<PilotSample>> = (0..k)
+        let samples: Vec<Result<PilotSample>> = (0..k)
             .into_par_iter()
             .map(|i| {
                 let (c, _) = self.clone_with(
@@ -643,9 +643,8 @@ impl CloneModel {
                 Ok((surf, meas, ins))
             })
             .collect();
-        let triples = pairs.into_iter().collect::<Result<Vec<_>>>()?;
-        let (prediction, prediction_sd) = fit_roundness_prediction(&triples);
-        let pairs: Vec<([f64; 5], [f64; 5])> = triples.iter().map(|t| (t.0, t.1)).collect();
+        let pairs = samples.into_iter().collect::<Result<Vec<_>>>()?;
+        let (prediction, prediction_sd) = fit_roundness_prediction(&pairs);
         let mut map = SteeringMap::identity(parent_mean);
         map.pilot_clones = pairs.len();
         map.roundness_prediction = prediction;

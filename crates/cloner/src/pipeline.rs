@@ -649,6 +649,31 @@ impl CloneModel {
         self.clone_with(index, Mode::Production, self.params.outputs, clock)
     }
 
+    /// The candidate's raw field polished again toward a surface roundness
+    /// `shift` below its steering target, then quality control ([`Self::shape`]):
+    /// the re-steered pass of a roundness repair or prediction.
+    fn resteer(
+        &self,
+        cand: &Candidate,
+        shift: f64,
+        s: &mut Scratch,
+        stats: &mut RunStats,
+        clock: &dyn Clock,
+    ) -> std::result::Result<Candidate, Reject> {
+        let mut steer = cand.steering;
+        steer.roundness -= shift;
+        self.ellipsoid(cand.semi, &mut s.r_ell);
+        self.shape(
+            cand.targets,
+            steer,
+            cand.semi,
+            cand.raw_roundness,
+            s,
+            stats,
+            clock,
+        )
+    }
+
     pub(crate) fn clone_with(
         &self,
         index: u64,
@@ -708,13 +733,9 @@ impl CloneModel {
                         break;
                     }
                     stats.roundness_predictions += 1;
-                    let mut steer = cand.steering;
-                    steer.roundness -= miss / pred[1];
-                    self.ellipsoid(cand.semi, &mut s.r_ell);
-                    let (goal, semi, raw) = (cand.targets, cand.semi, cand.raw_roundness);
                     // a pass that fails (quality control, polishing) keeps the
                     // candidate as it was
-                    match self.shape(goal, steer, semi, raw, &mut s, &mut stats, clock) {
+                    match self.resteer(&cand, miss / pred[1], &mut s, &mut stats, clock) {
                         Ok(c) => cand = c,
                         Err(_) => break,
                     }
@@ -756,11 +777,8 @@ impl CloneModel {
                     repairs += 1;
                     stats.roundness_repairs += 1;
                     let slope = self.steering_map().slope[3];
-                    let mut steer = cand.steering;
-                    steer.roundness -= miss / if slope > 0.1 { slope } else { 1.0 };
-                    self.ellipsoid(cand.semi, &mut s.r_ell);
-                    let (goal, semi, raw) = (cand.targets, cand.semi, cand.raw_roundness);
-                    match self.shape(goal, steer, semi, raw, &mut s, &mut stats, clock) {
+                    let shift = miss / if slope > 0.1 { slope } else { 1.0 };
+                    match self.resteer(&cand, shift, &mut s, &mut stats, clock) {
                         Ok(c) => cand = c,
                         Err(r) => break Err(r),
                     }
