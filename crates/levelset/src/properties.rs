@@ -75,7 +75,25 @@ struct Integrals<const AREA: bool, const MOMENTS: bool> {
     vol6: f64,
     area2: f64,
     first24: Vector3<f64>,
-    second120: Matrix3<f64>,
+    /// The upper triangle of `120 ∫ x xᵀ dV` (xx, xy, xz, yy, yz, zz): the tensor is
+    /// symmetric, so six sums instead of nine (each the same expression, in the same order,
+    /// as the full matrix's element).
+    second120: [f64; 6],
+}
+
+/// `(row, column)` of each entry of [`Integrals::second120`].
+const UPPER: [(usize, usize); 6] = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
+
+impl<const AREA: bool, const MOMENTS: bool> Integrals<AREA, MOMENTS> {
+    /// The full symmetric matrix of [`Integrals::second120`].
+    fn second120(&self) -> Matrix3<f64> {
+        let mut m = Matrix3::zeros();
+        for (&(i, j), &v) in UPPER.iter().zip(&self.second120) {
+            m[(i, j)] = v;
+            m[(j, i)] = v;
+        }
+        m
+    }
 }
 
 impl<const AREA: bool, const MOMENTS: bool> Sink for Integrals<AREA, MOMENTS> {
@@ -97,8 +115,9 @@ impl<const AREA: bool, const MOMENTS: bool> Sink for Integrals<AREA, MOMENTS> {
         if MOMENTS {
             let s = a + b + c;
             self.first24 += det * s;
-            self.second120 += det
-                * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+            for (acc, &(i, j)) in self.second120.iter_mut().zip(&UPPER) {
+                *acc += det * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j]);
+            }
         }
     }
 }
@@ -162,19 +181,20 @@ impl Grid {
     /// [`Error::NoSurface`] if the enclosed volume is not positive.
     pub fn mass_properties(&self) -> Result<MassProperties> {
         let (mut s, corrections) = self.integrate::<true, true, true>();
+        let mut second120 = s.second120();
         for cc in corrections {
             let x = cc.centre.coords - s.o;
             s.vol6 += 6.0 * cc.dv;
             s.first24 += 24.0 * cc.dv * x;
             // A point mass dv at x adds dv·x to ∫ x dV and dv·x xᵀ to ∫ x xᵀ dV.
-            s.second120 += 120.0 * cc.dv * x * x.transpose();
+            second120 += 120.0 * cc.dv * x * x.transpose();
         }
         let volume = s.vol6 / 6.0;
         if volume.is_nan() || volume <= 0.0 {
             return Err(Error::NoSurface);
         }
         let c = s.first24 / 24.0 / volume;
-        let second = s.second120 / 120.0 - volume * c * c.transpose();
+        let second = second120 / 120.0 - volume * c * c.transpose();
         let inertia = Matrix3::identity() * second.trace() - second;
         Ok(MassProperties {
             volume,

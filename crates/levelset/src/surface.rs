@@ -92,14 +92,38 @@ fn corner_vec(c: u8) -> Vector3<f64> {
     )
 }
 
+/// [`corner_vec`] of every corner mask (a lookup instead of three integer conversions).
+const CORNERS: [[f64; 3]; 8] = {
+    let mut t = [[0.0; 3]; 8];
+    let mut c = 0;
+    while c < 8 {
+        t[c] = [(c & 1) as f64, ((c >> 1) & 1) as f64, ((c >> 2) & 1) as f64];
+        c += 1;
+    }
+    t
+};
+
+#[inline]
+fn corner_of(c: u8) -> Vector3<f64> {
+    let [x, y, z] = CORNERS[usize::from(c & 7)];
+    Vector3::new(x, y, z)
+}
+
 /// Triangles of the cube's sign patterns, assembled from those of the six tetrahedra
 /// (oriented edge lists for all 16 sign patterns of each, built first).
 struct TetTable {
-    /// For every sign pattern of the cube (256): its triangles as edge slots
-    /// ([`EDGE_SLOT`]), in the order of the tetrahedra and of `tris` (the order the walk
-    /// emits them), `cube[cube_off[m]..cube_off[m + 1]]`.
-    cube: Vec<[u8; 3]>,
+    /// For every sign pattern of the cube (256): the span `cube_off[m]..cube_off[m + 1]`
+    /// of its triangles in `local` (in the order of the tetrahedra and of `tris`: the order
+    /// the walk emits them).
     cube_off: [u16; 257],
+    /// For every sign pattern: the edge slots its triangles use, each once, in the order
+    /// of their first use in `cube` (the order the walk creates the vertices),
+    /// `used[used_off[m]..used_off[m + 1]]`.
+    used: Vec<u8>,
+    used_off: [u16; 257],
+    /// The triangles, each vertex as the position of its edge slot ([`EDGE_SLOT`]) in the
+    /// pattern's `used` list.
+    local: Vec<[u8; 3]>,
     /// Corners `(lo, hi)` of every edge slot.
     ends: [(u8, u8); 19],
 }
@@ -182,9 +206,32 @@ fn build_table() -> TetTable {
         // at most 12 triangles per cube: 256·12 fits u16
         cube_off[cmask + 1] = u16::try_from(cube.len()).unwrap_or(u16::MAX);
     }
+    let mut used = Vec::new();
+    let mut used_off = [0u16; 257];
+    let mut local = Vec::with_capacity(cube.len());
+    for cmask in 0usize..256 {
+        let start = used.len();
+        for tri in &cube[usize::from(cube_off[cmask])..usize::from(cube_off[cmask + 1])] {
+            local.push(tri.map(|slot| {
+                let at = used[start..]
+                    .iter()
+                    .position(|&u| u == slot)
+                    .unwrap_or_else(|| {
+                        used.push(slot);
+                        used.len() - 1 - start
+                    });
+                // at most 19 slots per pattern
+                u8::try_from(at).unwrap_or(u8::MAX)
+            }));
+        }
+        // at most 19 slots per cube: 256·19 fits u16
+        used_off[cmask + 1] = u16::try_from(used.len()).unwrap_or(u16::MAX);
+    }
     TetTable {
-        cube,
         cube_off,
+        used,
+        used_off,
+        local,
         ends,
     }
 }
@@ -268,46 +315,39 @@ pub(crate) fn walk<S: Sink>(spec: &GridSpec, values: &[f64], sink: &mut S) {
                     }
                     sink.cell(i, j, k);
                     let base = spec.node(i, j, k);
-                    let mut cache: [Option<S::V>; 19] = [None; 19];
-                    let span = usize::from(tab.cube_off[usize::from(cmask)])
-                        ..usize::from(tab.cube_off[usize::from(cmask) + 1]);
-                    for tri in &tab.cube[span] {
-                        let mut handles = [None; 3];
-                        for (slot, &key) in tri.iter().enumerate() {
-                            let key = usize::from(key);
-                            let hnd = match cache[key] {
-                                Some(v) => v,
-                                None => {
-                                    let (lo, hi) = tab.ends[key];
-                                    let fa = if phi[lo as usize] < 0.0 {
-                                        phi[lo as usize]
-                                    } else {
-                                        phi[lo as usize].max(delta)
-                                    };
-                                    let fb = if phi[hi as usize] < 0.0 {
-                                        phi[hi as usize]
-                                    } else {
-                                        phi[hi as usize].max(delta)
-                                    };
-                                    let tpar = fa / (fa - fb);
-                                    let d = hi ^ lo;
-                                    let p = base + h * (corner_vec(lo) + tpar * corner_vec(d));
-                                    let v = sink.vertex(
-                                        i + (lo & 1) as usize,
-                                        j + ((lo >> 1) & 1) as usize,
-                                        k + ((lo >> 2) & 1) as usize,
-                                        d,
-                                        p,
-                                    );
-                                    cache[key] = Some(v);
-                                    v
-                                }
-                            };
-                            handles[slot] = Some(hnd);
-                        }
-                        if let [Some(x), Some(y), Some(z)] = handles {
-                            sink.triangle([x, y, z]);
-                        }
+                    let m = usize::from(cmask);
+                    let used =
+                        &tab.used[usize::from(tab.used_off[m])..usize::from(tab.used_off[m + 1])];
+                    // the vertices of the pattern's edges, in the order of their first use
+                    // (the order the sink numbers them in)
+                    let vertex = |sink: &mut S, slot: u8| {
+                        let (lo, hi) = tab.ends[usize::from(slot)];
+                        let fa = phi[lo as usize];
+                        let fa = if fa < 0.0 { fa } else { fa.max(delta) };
+                        let fb = phi[hi as usize];
+                        let fb = if fb < 0.0 { fb } else { fb.max(delta) };
+                        let tpar = fa / (fa - fb);
+                        let d = hi ^ lo;
+                        let p = base + h * (corner_of(lo) + tpar * corner_of(d));
+                        sink.vertex(
+                            i + (lo & 1) as usize,
+                            j + ((lo >> 1) & 1) as usize,
+                            k + ((lo >> 2) & 1) as usize,
+                            d,
+                            p,
+                        )
+                    };
+                    let Some((&first_slot, rest)) = used.split_first() else {
+                        continue;
+                    };
+                    let first = vertex(sink, first_slot);
+                    let mut handles = [first; 19];
+                    for (hnd, &slot) in handles[1..].iter_mut().zip(rest) {
+                        *hnd = vertex(sink, slot);
+                    }
+                    let span = usize::from(tab.cube_off[m])..usize::from(tab.cube_off[m + 1]);
+                    for tri in &tab.local[span] {
+                        sink.triangle(tri.map(|l| handles[usize::from(l)]));
                     }
                 }
             }
