@@ -143,9 +143,16 @@ impl Clipper {
             let face = &self.poly.pts[start..end];
             start = end;
             let first = self.next.pts.len();
+            // each corner's plane value once (it is the end of one edge and the start of
+            // the next)
+            let Some(p0) = face.first() else { continue };
+            let f0 = f(p0);
+            let mut fp = f0;
             for (idx, p) in face.iter().enumerate() {
-                let q = &face[(idx + 1) % face.len()];
-                let (fp, fq) = (f(p), f(q));
+                let (q, fq) = match face.get(idx + 1) {
+                    Some(q) => (q, f(q)),
+                    None => (p0, f0),
+                };
                 if fp <= 0.0 {
                     self.next.pts.push(*p);
                 }
@@ -154,6 +161,7 @@ impl Clipper {
                     self.next.pts.push(x);
                     self.cut.push(x);
                 }
+                fp = fq;
             }
             self.next.close_face(first);
         }
@@ -364,7 +372,8 @@ fn cell_correction(
     let off: [usize; 8] =
         std::array::from_fn(|c| (c & 1) + nx * ((c >> 1) & 1) + nx * ny * ((c >> 2) & 1));
     let base = spec.node(i, j, k);
-    let corner = |c: usize| base + h * corner_vec(c as u8);
+    let corners: [Point3<f64>; 8] = std::array::from_fn(|c| base + h * corner_vec(c as u8));
+    let corner = |c: usize| corners[c];
     // Corner planes φ_c + n_c·(y − x_c), as (a, n) with a = φ_c − n_c·x_c.
     let mut planes = [(0.0, Vector3::zeros()); 8];
     let mut count = 0;

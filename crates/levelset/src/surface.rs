@@ -444,7 +444,8 @@ impl Grid {
     pub fn marching_cubes(&self) -> TriMesh {
         with_closed_values(self, |spec, values| {
             // Reserve from the number of sign changes along x (a sphere gives ≈ 9 vertices
-            // and ≈ 18 triangles per x crossing): avoids regrowing the buffers.
+            // and ≈ 18 triangles per x crossing, cloned grains 10–14 and 21–29): avoids
+            // regrowing the buffers (the pages of an over-reserved tail are never touched).
             let crossings: usize = values
                 .chunks_exact(spec.dims[0])
                 .map(|row| {
@@ -458,8 +459,8 @@ impl Grid {
                 ny: spec.dims[1],
                 cache: vec![0; 2 * spec.dims[0] * spec.dims[1] * 8],
                 written: [Vec::new(), Vec::new()],
-                vertices: Vec::with_capacity(10 * crossings + 16),
-                triangles: Vec::with_capacity(20 * crossings + 16),
+                vertices: Vec::with_capacity(16 * crossings + 16),
+                triangles: Vec::with_capacity(32 * crossings + 16),
             };
             walk(spec, values, &mut sink);
             TriMesh::from_parts_unchecked(sink.vertices, sink.triangles)
