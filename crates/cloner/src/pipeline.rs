@@ -56,7 +56,7 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use levelset::{Grid, GridSpec, StarParams};
-use morph_dna::{Descriptor, DnaTable, MeasureParams, measure};
+use morph_dna::{Descriptor, DnaTable, MeasureParams, Measurement};
 use nalgebra::Point3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -259,7 +259,21 @@ impl RunStats {
 }
 
 /// [`DNA`] without the roundness (index 2), in order.
-const DNA_BUT_ROUNDNESS: [Descriptor; 5] = [DNA[0], DNA[1], DNA[3], DNA[4], DNA[5]];
+/// A clone's level set, alone or inside the measurement that holds its
+/// surface and measured descriptors.
+enum Held {
+    Grid(Grid),
+    Measured(Box<Measurement<'static>>),
+}
+
+impl Held {
+    fn into_grid(self) -> Grid {
+        match self {
+            Self::Grid(g) => g,
+            Self::Measured(m) => m.into_grid(),
+        }
+    }
+}
 
 /// One accepted clone.
 #[derive(Debug, Clone, PartialEq)]
@@ -753,12 +767,16 @@ impl CloneModel {
                         break Err(Reject::Degenerate);
                     };
                     let Some(t) = check_roundness else {
-                        break Ok((g, None));
+                        break Ok((Held::Grid(g), None));
                     };
                     // the roundness check first, on roundness alone (morph-dna
                     // computes each descriptor identically alone or in a set),
-                    // so a rejected clone does not pay for the volume pass
-                    let r = measure(&g, &[Descriptor::Roundness], &MeasureParams::default());
+                    // so a rejected clone does not pay for the volume pass; the
+                    // measurement keeps the surface it extracted for the rest
+                    let Ok(mut m) = Measurement::owned(g, &MeasureParams::default()) else {
+                        break Err(Reject::Degenerate);
+                    };
+                    let r = m.get(&[Descriptor::Roundness]);
                     stats.times.measure_ns += clock.now_ns() - t1;
                     let r = match r {
                         Ok(r) => r[0],
@@ -766,7 +784,7 @@ impl CloneModel {
                     };
                     let miss = r - cand.targets.roundness;
                     if miss.abs() <= t {
-                        break Ok((g, Some(r)));
+                        break Ok((Held::Measured(Box::new(m)), Some(r)));
                     }
                     if repairs == self.params.roundness_repairs {
                         break Err(Reject::MeasuredRoundness);
@@ -783,41 +801,38 @@ impl CloneModel {
                         Err(r) => break Err(r),
                     }
                 };
-                let (g, roundness) = match g {
+                let (held, roundness) = match g {
                     Ok(v) => v,
                     Err(r) => {
                         stats.rejections.count(r);
                         continue;
                     }
                 };
-                if measure_dna {
+                let held = if measure_dna && (outputs.dna || roundness.is_none()) {
                     let t1 = clock.now_ns();
-                    let mp = MeasureParams::default();
-                    let d = match roundness {
-                        Some(_) if !outputs.dna => Ok(Vec::new()),
-                        // the other five, with the roundness already known
-                        Some(r) => measure(&g, &DNA_BUT_ROUNDNESS, &mp).map(|v| {
-                            let mut d = v;
-                            d.insert(2, r);
-                            d
-                        }),
-                        None => measure(&g, &DNA, &mp),
+                    // the roundness and the surface are reused when the check
+                    // measured them
+                    let m = match held {
+                        Held::Measured(m) => Ok(*m),
+                        Held::Grid(g) => Measurement::owned(g, &MeasureParams::default()),
                     };
+                    let d = m.and_then(|mut m| m.get(&DNA).map(|d| (d, m)));
                     stats.times.measure_ns += clock.now_ns() - t1;
                     match d {
-                        Ok(d) => {
-                            if outputs.dna {
-                                dna = Some(d);
-                            }
+                        Ok((d, m)) => {
+                            dna = Some(d);
+                            Held::Measured(Box::new(m))
                         }
                         Err(_) => {
                             stats.rejections.degenerate += 1;
                             continue;
                         }
                     }
-                }
+                } else {
+                    held
+                };
                 if outputs.level_set {
-                    grid = Some(g);
+                    grid = Some(held.into_grid());
                 }
             }
             stats.accepted += 1;

@@ -320,14 +320,49 @@ impl MeshGeometry {
         if r.len() != self.n_nodes() || r.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
             return None;
         }
-        let pts: Vec<Vector3<f64>> = self.dirs.iter().zip(r).map(|(u, &v)| u * v).collect();
-        let nearest2 = |c: &Vector3<f64>| {
-            pts.iter()
-                .map(|p| (p - c).norm_squared())
-                .fold(f64::INFINITY, f64::min)
+        // the nodes as coordinate arrays, in chunks of `LANES` (padded by copies of
+        // the first node, which change no minimum)
+        const LANES: usize = 8;
+        let n = r.len().div_ceil(LANES) * LANES;
+        let mut xyz = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        for (i, (u, &v)) in self.dirs.iter().zip(r).enumerate() {
+            let p = u * v;
+            for a in 0..3 {
+                xyz[a][i] = p[a];
+            }
+        }
+        for coord in &mut xyz {
+            let first = coord[0];
+            coord[r.len()..].fill(first);
+        }
+        // the squared distance from `c` to the nearest node if it exceeds `floor`,
+        // else None (stops at the first chunk at or below `floor`); the same value
+        // as the full minimum, whose terms are each `(x−cx)² + (y−cy)² + (z−cz)²`
+        let nearest2_above = |c: &Vector3<f64>, floor: f64| {
+            let mut m = f64::INFINITY;
+            for ((xs, ys), zs) in xyz[0]
+                .chunks_exact(LANES)
+                .zip(xyz[1].chunks_exact(LANES))
+                .zip(xyz[2].chunks_exact(LANES))
+            {
+                let mut lane = [f64::INFINITY; LANES];
+                for l in 0..LANES {
+                    let (dx, dy, dz) = (xs[l] - c.x, ys[l] - c.y, zs[l] - c.z);
+                    let d = dx * dx + dy * dy + dz * dz;
+                    lane[l] = if d < lane[l] { d } else { lane[l] };
+                }
+                let cm = lane
+                    .iter()
+                    .fold(f64::INFINITY, |a, &b| if b < a { b } else { a });
+                if cm <= floor {
+                    return None;
+                }
+                m = if cm < m { cm } else { m };
+            }
+            Some(m)
         };
         let mut c = Vector3::zeros();
-        let mut best2 = nearest2(&c);
+        let mut best2 = nearest2_above(&c, f64::NEG_INFINITY)?;
         let mut step = 0.25 * best2.sqrt();
         for _ in 0..200 {
             let mut moved = false;
@@ -335,8 +370,7 @@ impl MeshGeometry {
                 for sign in [-1.0, 1.0] {
                     let mut q = c;
                     q[a] += sign * step;
-                    let d2 = nearest2(&q);
-                    if d2 > best2 {
+                    if let Some(d2) = nearest2_above(&q, best2) {
                         best2 = d2;
                         c = q;
                         moved = true;

@@ -91,3 +91,4 @@ pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
 pub use star::{
     BAND_CELLS, DirectionTable, Redistance, StarBuild, StarParams, cube_map_directions,
 };
+pub use surface::Surface;

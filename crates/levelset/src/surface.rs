@@ -314,7 +314,6 @@ pub(crate) fn walk<S: Sink>(spec: &GridSpec, values: &[f64], sink: &mut S) {
                         continue;
                     }
                     sink.cell(i, j, k);
-                    let base = spec.node(i, j, k);
                     let m = usize::from(cmask);
                     let used =
                         &tab.used[usize::from(tab.used_off[m])..usize::from(tab.used_off[m + 1])];
@@ -328,14 +327,16 @@ pub(crate) fn walk<S: Sink>(spec: &GridSpec, values: &[f64], sink: &mut S) {
                         let fb = if fb < 0.0 { fb } else { fb.max(delta) };
                         let tpar = fa / (fa - fb);
                         let d = hi ^ lo;
-                        let p = base + h * (corner_of(lo) + tpar * corner_of(d));
-                        sink.vertex(
+                        let (gi, gj, gk) = (
                             i + (lo & 1) as usize,
                             j + ((lo >> 1) & 1) as usize,
                             k + ((lo >> 2) & 1) as usize,
-                            d,
-                            p,
-                        )
+                        );
+                        // from the edge's own start node, so that every cell sharing the
+                        // edge computes the same point bit for bit (the integrals over the
+                        // walk and over the extracted mesh agree exactly)
+                        let p = spec.node(gi, gj, gk) + (h * tpar) * corner_of(d);
+                        sink.vertex(gi, gj, gk, d, p)
                     };
                     let Some((&first_slot, rest)) = used.split_first() else {
                         continue;
@@ -403,6 +404,8 @@ struct MeshSink {
     written: [Vec<usize>; 2],
     vertices: Vec<Point3<f64>>,
     triangles: Vec<[usize; 3]>,
+    /// The mixed cells, when recorded.
+    cells: Option<Vec<[u32; 3]>>,
 }
 
 impl Sink for MeshSink {
@@ -435,6 +438,13 @@ impl Sink for MeshSink {
     fn triangle(&mut self, t: [usize; 3]) {
         self.triangles.push(t);
     }
+
+    fn cell(&mut self, i: usize, j: usize, k: usize) {
+        if let Some(c) = &mut self.cells {
+            // grids are far below 2³² nodes per axis (GridSpec limits the node count)
+            c.push([i, j, k].map(|x| u32::try_from(x).unwrap_or(u32::MAX)));
+        }
+    }
 }
 
 impl Grid {
@@ -442,29 +452,100 @@ impl Grid {
     /// the module docs): closed, consistently oriented (outward normals), one vertex per
     /// crossed grid edge. Empty if the grid has no negative node.
     pub fn marching_cubes(&self) -> TriMesh {
+        with_closed_values(self, |spec, values| extract(spec, values, false).0)
+    }
+
+    /// [`Grid::marching_cubes`] together with the cells the surface crosses: what
+    /// [`Surface::mass_properties`] needs to integrate over the extracted mesh instead of
+    /// walking the grid again (the same values bit for bit as [`Grid::mass_properties`]).
+    pub fn surface(&self) -> Surface {
         with_closed_values(self, |spec, values| {
-            // Reserve from the number of sign changes along x (a sphere gives ≈ 9 vertices
-            // and ≈ 18 triangles per x crossing, cloned grains 10–14 and 21–29): avoids
-            // regrowing the buffers (the pages of an over-reserved tail are never touched).
-            let crossings: usize = values
-                .chunks_exact(spec.dims[0])
-                .map(|row| {
-                    row.windows(2)
-                        .filter(|w| (w[0] < 0.0) != (w[1] < 0.0))
-                        .count()
-                })
-                .sum();
-            let mut sink = MeshSink {
-                nx: spec.dims[0],
-                ny: spec.dims[1],
-                cache: vec![0; 2 * spec.dims[0] * spec.dims[1] * 8],
-                written: [Vec::new(), Vec::new()],
-                vertices: Vec::with_capacity(16 * crossings + 16),
-                triangles: Vec::with_capacity(32 * crossings + 16),
-            };
-            walk(spec, values, &mut sink);
-            TriMesh::from_parts_unchecked(sink.vertices, sink.triangles)
+            let (mesh, cells) = extract(spec, values, true);
+            let fingerprint = fingerprint(spec, values, &cells);
+            Surface {
+                mesh,
+                cells,
+                spec: *self.spec(),
+                fingerprint,
+            }
         })
+    }
+}
+
+/// The mesh of the (closed) values and, if `record`, the mixed cells in walk order.
+fn extract(spec: &GridSpec, values: &[f64], record: bool) -> (TriMesh, Vec<[u32; 3]>) {
+    // Reserve from the number of sign changes along x (a sphere gives ≈ 9 vertices and
+    // ≈ 18 triangles per x crossing, cloned grains 10–14 and 21–29): avoids regrowing the
+    // buffers (the pages of an over-reserved tail are never touched).
+    let crossings: usize = values
+        .chunks_exact(spec.dims[0])
+        .map(|row| {
+            row.windows(2)
+                .filter(|w| (w[0] < 0.0) != (w[1] < 0.0))
+                .count()
+        })
+        .sum();
+    let mut sink = MeshSink {
+        nx: spec.dims[0],
+        ny: spec.dims[1],
+        cache: vec![0; 2 * spec.dims[0] * spec.dims[1] * 8],
+        written: [Vec::new(), Vec::new()],
+        vertices: Vec::with_capacity(16 * crossings + 16),
+        triangles: Vec::with_capacity(32 * crossings + 16),
+        cells: record.then(|| Vec::with_capacity(8 * crossings + 16)),
+    };
+    walk(spec, values, &mut sink);
+    (
+        TriMesh::from_parts_unchecked(sink.vertices, sink.triangles),
+        sink.cells.unwrap_or_default(),
+    )
+}
+
+/// A hash of the values at the base nodes of `cells` (and of their number): what ties a
+/// [`Surface`] to the grid it was extracted from.
+fn fingerprint(spec: &GridSpec, values: &[f64], cells: &[[u32; 3]]) -> u64 {
+    let [nx, ny, _] = spec.dims;
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325 ^ cells.len() as u64;
+    for &[i, j, k] in cells {
+        let b = i as usize + nx * (j as usize + ny * k as usize);
+        h = (h ^ values.get(b).map_or(u64::MAX, |v| v.to_bits())).wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+/// The zero surface of a grid extracted once ([`Grid::surface`]): its triangle mesh and the
+/// grid cells it crosses. [`Surface::mass_properties`] integrates over the mesh (no second
+/// pass over the grid), bit for bit as [`Grid::mass_properties`].
+#[derive(Debug, Clone)]
+pub struct Surface {
+    mesh: TriMesh,
+    /// The mixed cells in walk order (indices into the walked grid: padded by one node on
+    /// every side if the grain touches the boundary).
+    cells: Vec<[u32; 3]>,
+    spec: GridSpec,
+    fingerprint: u64,
+}
+
+impl Surface {
+    /// The mesh ([`Grid::marching_cubes`]).
+    pub fn mesh(&self) -> &TriMesh {
+        &self.mesh
+    }
+
+    /// The mesh, by value.
+    pub fn into_mesh(self) -> TriMesh {
+        self.mesh
+    }
+
+    /// The cells crossed by the surface, in walk order, and the fingerprint.
+    pub(crate) fn cells(&self) -> &[[u32; 3]] {
+        &self.cells
+    }
+
+    /// Whether `grid` is the grid this surface was extracted from (same layout, same values
+    /// at the crossed cells).
+    pub(crate) fn matches(&self, grid: &Grid, spec: &GridSpec, values: &[f64]) -> bool {
+        *grid.spec() == self.spec && fingerprint(spec, values, &self.cells) == self.fingerprint
     }
 }
 

@@ -110,8 +110,8 @@ pub use grading::{GradingCoefficients, GradingCurve, GradingInterpolation, Gradi
 pub use histogram::{BinAxis, Histogram1d, Histogram2d};
 pub use hull::{convex_hull, convex_hull_volume};
 pub use measure::{
-    CornerAveraging, MeasureParams, PrincipalFrame, max_principal_curvature, measure, measure_star,
-    measure_table, measure_with_frame, principal_frame, radial_profile,
+    CornerAveraging, MeasureParams, Measurement, PrincipalFrame, max_principal_curvature, measure,
+    measure_star, measure_table, measure_with_frame, principal_frame, radial_profile,
 };
 pub use pdf::{Bandwidth, BicubicPdf, GaussianKde2d, TabulatedPdf2d};
 pub use radial::{

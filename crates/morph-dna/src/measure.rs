@@ -43,7 +43,9 @@
 
 use nalgebra::{Matrix3, Point3, Unit, Vector3};
 
-use levelset::{Grid, GridSpec, MassProperties, StarParams};
+use std::borrow::Cow;
+
+use levelset::{Grid, GridSpec, MassProperties, StarParams, Surface};
 
 use crate::error::{Error, Result};
 use crate::hull::convex_hull_volume;
@@ -476,115 +478,230 @@ fn measure_impl(
     params: &MeasureParams,
     with_frame: bool,
 ) -> Result<(Vec<f64>, Option<PrincipalFrame>)> {
-    params.validate()?;
-    let mut needs = Needs::of(wanted);
-    if with_frame {
-        needs.volume = true;
-        needs.principal = true;
+    let mut m = Measurement::new(grid, params)?;
+    let values = m.get(wanted)?;
+    let frame = if with_frame { Some(m.frame()?) } else { None };
+    Ok((values, frame))
+}
+
+/// The descriptors of one grid, measured on request: what they share (the surface mesh,
+/// the mass properties, the principal axes, the roundness) is computed once, at the first
+/// request that needs it, and kept for the next. Each descriptor has the same value, bit for
+/// bit, whatever was asked before or with it (the mass properties over an extracted surface
+/// equal those of a separate pass, [`levelset::Grid::mass_properties_of`]), so a pipeline
+/// can ask for a cheap descriptor first and for the rest only if the grain passes:
+/// `get(&[Roundness])`, then `get(&[Volume, …])` reuses the mesh the roundness extracted.
+///
+/// The grid is borrowed ([`Measurement::new`]) or owned ([`Measurement::owned`], handed
+/// back by [`Measurement::into_grid`]).
+#[derive(Debug, Clone)]
+pub struct Measurement<'g> {
+    grid: Cow<'g, Grid>,
+    params: MeasureParams,
+    surface: Option<Surface>,
+    mass: Option<MassProperties>,
+    principal: Option<levelset::Principal>,
+    roundness: Option<f64>,
+}
+
+impl<'g> Measurement<'g> {
+    /// A measurement of a borrowed grid.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for invalid params; [`Error::LevelSet`] for a grid whose
+    /// every node is inside.
+    pub fn new(grid: &'g Grid, params: &MeasureParams) -> Result<Self> {
+        Self::with(Cow::Borrowed(grid), params)
     }
-    if grid.values().iter().all(|v| *v < 0.0) {
-        return Err(Error::LevelSet {
-            message: "every node is inside: the grain does not fit in its grid".into(),
-        });
+
+    /// A measurement that owns its grid.
+    ///
+    /// # Errors
+    /// As [`Measurement::new`].
+    pub fn owned(grid: Grid, params: &MeasureParams) -> Result<Measurement<'static>> {
+        Measurement::with(Cow::Owned(grid), params)
     }
-    let mesh = if needs.mesh {
-        Some(grid.marching_cubes())
-    } else {
-        None
-    };
-    // levelset's integrals (with its sharp-feature volume correction), so
-    // that a descriptor does not depend on what else is asked for
-    let mp = if needs.volume {
-        Some(grid.mass_properties().map_err(ls_err)?)
-    } else {
-        None
-    };
-    let (volume, area) = mp
-        .as_ref()
-        .map_or((f64::NAN, f64::NAN), |m| (m.volume, m.area));
-    // principal axes up to sign: dimensions and extents do not depend on
-    // the signs that `principal_frame` fixes (flipping an axis negates the
-    // projections exactly, so the extents are the same bit for bit)
-    let principal = match &mp {
-        Some(m) if needs.principal => Some(m.principal()),
-        _ => None,
-    };
-    let dims = match (&principal, &mp) {
-        (Some(p), Some(m)) => Some(inertia_ellipsoid_dimensions(&p.moments, m.volume)?),
-        _ => None,
-    };
-    let extents = match (&principal, &mp, &mesh) {
-        (Some(p), Some(m), Some(mesh))
-            if wanted.iter().any(|d| {
-                matches!(
-                    d,
-                    Descriptor::MajorExtent
-                        | Descriptor::IntermediateExtent
-                        | Descriptor::MinorExtent
-                )
-            }) =>
-        {
-            let e0: Vector3<f64> = p.axes.column(0).into_owned();
-            let e1: Vector3<f64> = p.axes.column(1).into_owned();
-            let axes = Matrix3::from_columns(&[e0, e1, e0.cross(&e1)]);
-            let mut out = [0.0; 3];
-            for (a, o) in out.iter_mut().enumerate() {
-                let axis = axes.column(a);
-                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-                for q in mesh.vertices() {
-                    let s = (q - m.centroid).dot(&axis);
-                    lo = lo.min(s);
-                    hi = hi.max(s);
-                }
-                *o = hi - lo;
-            }
-            Some(out)
-        }
-        _ => None,
-    };
-    let mut out = Vec::with_capacity(wanted.len());
-    for &d in wanted {
-        let v = match d {
-            Descriptor::Volume => volume,
-            Descriptor::SurfaceArea => area,
-            Descriptor::VolumeSurfaceRatio => volume / area,
-            Descriptor::EquivalentDiameter => (6.0 * volume / std::f64::consts::PI).cbrt(),
-            Descriptor::Sphericity => {
-                std::f64::consts::PI.cbrt() * (6.0 * volume).powf(2.0 / 3.0) / area
-            }
-            Descriptor::MajorPrincipalDimension => dims.map_or(f64::NAN, |x| x[0]),
-            Descriptor::IntermediatePrincipalDimension => dims.map_or(f64::NAN, |x| x[1]),
-            Descriptor::MinPrincipalDimension => dims.map_or(f64::NAN, |x| x[2]),
-            Descriptor::AspectRatio => dims.map_or(f64::NAN, |x| x[2] / x[0]),
-            Descriptor::Elongation => dims.map_or(f64::NAN, |x| x[1] / x[0]),
-            Descriptor::Flatness => dims.map_or(f64::NAN, |x| x[2] / x[1]),
-            Descriptor::MajorExtent => extents.map_or(f64::NAN, |x| x[0]),
-            Descriptor::IntermediateExtent => extents.map_or(f64::NAN, |x| x[1]),
-            Descriptor::MinorExtent => extents.map_or(f64::NAN, |x| x[2]),
-            Descriptor::Convexity => {
-                let Some(m) = &mesh else { unreachable_state()? };
-                let hull = convex_hull_volume(m.vertices())?;
-                (volume / hull).min(1.0)
-            }
-            Descriptor::Roundness => {
-                let Some(m) = &mesh else { unreachable_state()? };
-                roundness(grid, m, params)?
-            }
-        };
-        if !v.is_finite() {
-            return Err(Error::InvalidParameter {
-                name: "grain",
-                value: v,
-                reason: "a grain whose descriptors are finite (degenerate geometry)",
+
+    fn with(grid: Cow<'g, Grid>, params: &MeasureParams) -> Result<Self> {
+        params.validate()?;
+        if grid.values().iter().all(|v| *v < 0.0) {
+            return Err(Error::LevelSet {
+                message: "every node is inside: the grain does not fit in its grid".into(),
             });
         }
-        out.push(v);
+        Ok(Self {
+            grid,
+            params: *params,
+            surface: None,
+            mass: None,
+            principal: None,
+            roundness: None,
+        })
     }
-    let frame = match (&mp, &principal) {
-        (Some(m), Some(p)) if with_frame => Some(frame_from(grid, m, p)),
-        _ => None,
-    };
-    Ok((out, frame))
+
+    /// The grid measured.
+    pub fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The grid (a copy if it was borrowed).
+    pub fn into_grid(self) -> Grid {
+        self.grid.into_owned()
+    }
+
+    /// The requested descriptors, in order (see [`measure`]).
+    ///
+    /// # Errors
+    /// As [`measure`].
+    pub fn get(&mut self, wanted: &[Descriptor]) -> Result<Vec<f64>> {
+        let needs = Needs::of(wanted);
+        if needs.mesh {
+            self.surface()?;
+        }
+        if needs.volume {
+            self.mass()?;
+        }
+        if needs.principal {
+            self.principal()?;
+        }
+        let (volume, area) = self
+            .mass
+            .as_ref()
+            .map_or((f64::NAN, f64::NAN), |m| (m.volume, m.area));
+        let dims = match (&self.principal, &self.mass) {
+            (Some(p), Some(m)) if needs.principal => {
+                Some(inertia_ellipsoid_dimensions(&p.moments, m.volume)?)
+            }
+            _ => None,
+        };
+        // principal axes up to sign: extents do not depend on the signs that
+        // `principal_frame` fixes (flipping an axis negates the projections exactly, so the
+        // extents are the same bit for bit)
+        let extents = match (&self.principal, &self.mass, &self.surface) {
+            (Some(p), Some(m), Some(surface))
+                if wanted.iter().any(|d| {
+                    matches!(
+                        d,
+                        Descriptor::MajorExtent
+                            | Descriptor::IntermediateExtent
+                            | Descriptor::MinorExtent
+                    )
+                }) =>
+            {
+                let e0: Vector3<f64> = p.axes.column(0).into_owned();
+                let e1: Vector3<f64> = p.axes.column(1).into_owned();
+                let axes = Matrix3::from_columns(&[e0, e1, e0.cross(&e1)]);
+                let mut out = [0.0; 3];
+                for (a, o) in out.iter_mut().enumerate() {
+                    let axis = axes.column(a);
+                    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                    for q in surface.mesh().vertices() {
+                        let s = (q - m.centroid).dot(&axis);
+                        lo = lo.min(s);
+                        hi = hi.max(s);
+                    }
+                    *o = hi - lo;
+                }
+                Some(out)
+            }
+            _ => None,
+        };
+        let mut out = Vec::with_capacity(wanted.len());
+        for &d in wanted {
+            let v = match d {
+                Descriptor::Volume => volume,
+                Descriptor::SurfaceArea => area,
+                Descriptor::VolumeSurfaceRatio => volume / area,
+                Descriptor::EquivalentDiameter => (6.0 * volume / std::f64::consts::PI).cbrt(),
+                Descriptor::Sphericity => {
+                    std::f64::consts::PI.cbrt() * (6.0 * volume).powf(2.0 / 3.0) / area
+                }
+                Descriptor::MajorPrincipalDimension => dims.map_or(f64::NAN, |x| x[0]),
+                Descriptor::IntermediatePrincipalDimension => dims.map_or(f64::NAN, |x| x[1]),
+                Descriptor::MinPrincipalDimension => dims.map_or(f64::NAN, |x| x[2]),
+                Descriptor::AspectRatio => dims.map_or(f64::NAN, |x| x[2] / x[0]),
+                Descriptor::Elongation => dims.map_or(f64::NAN, |x| x[1] / x[0]),
+                Descriptor::Flatness => dims.map_or(f64::NAN, |x| x[2] / x[1]),
+                Descriptor::MajorExtent => extents.map_or(f64::NAN, |x| x[0]),
+                Descriptor::IntermediateExtent => extents.map_or(f64::NAN, |x| x[1]),
+                Descriptor::MinorExtent => extents.map_or(f64::NAN, |x| x[2]),
+                Descriptor::Convexity => {
+                    let Some(surface) = &self.surface else {
+                        unreachable_state()?
+                    };
+                    let hull = convex_hull_volume(surface.mesh().vertices())?;
+                    (volume / hull).min(1.0)
+                }
+                Descriptor::Roundness => match self.roundness {
+                    Some(r) => r,
+                    None => {
+                        let Some(surface) = &self.surface else {
+                            unreachable_state()?
+                        };
+                        let r = roundness(&self.grid, surface.mesh(), &self.params)?;
+                        self.roundness = Some(r);
+                        r
+                    }
+                },
+            };
+            if !v.is_finite() {
+                return Err(Error::InvalidParameter {
+                    name: "grain",
+                    value: v,
+                    reason: "a grain whose descriptors are finite (degenerate geometry)",
+                });
+            }
+            out.push(v);
+        }
+        Ok(out)
+    }
+
+    /// The grain's [`PrincipalFrame`], as [`principal_frame`] gives it (the same values bit
+    /// for bit), from the cached mass properties.
+    ///
+    /// # Errors
+    /// As [`principal_frame`].
+    pub fn frame(&mut self) -> Result<PrincipalFrame> {
+        let p = self.principal()?;
+        let Some(m) = &self.mass else {
+            unreachable_state()?
+        };
+        Ok(frame_from(&self.grid, m, &p))
+    }
+
+    fn surface(&mut self) -> Result<&Surface> {
+        if self.surface.is_none() {
+            self.surface = Some(self.grid.surface());
+        }
+        match &self.surface {
+            Some(s) => Ok(s),
+            None => unreachable_state(),
+        }
+    }
+
+    /// levelset's integrals (with its sharp-feature volume correction), over the extracted
+    /// surface if there is one: the same values either way.
+    fn mass(&mut self) -> Result<MassProperties> {
+        if let Some(m) = self.mass {
+            return Ok(m);
+        }
+        let m = match &self.surface {
+            Some(s) => self.grid.mass_properties_of(s),
+            None => self.grid.mass_properties(),
+        }
+        .map_err(ls_err)?;
+        self.mass = Some(m);
+        Ok(m)
+    }
+
+    fn principal(&mut self) -> Result<levelset::Principal> {
+        if let Some(p) = self.principal {
+            return Ok(p);
+        }
+        let p = self.mass()?.principal();
+        self.principal = Some(p);
+        Ok(p)
+    }
 }
 
 fn unreachable_state<T>() -> Result<T> {

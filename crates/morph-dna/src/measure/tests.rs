@@ -373,3 +373,55 @@ fn each_descriptor_alone_equals_its_value_among_all() {
         }
     }
 }
+
+#[test]
+fn a_measurement_gives_each_value_whatever_was_asked_before() {
+    let p = MeasureParams::default();
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.02, -0.01, 0.03),
+        UnitQuaternion::from_euler_angles(0.4, -0.3, 0.9),
+    );
+    for g in [rounded_box(45, 1.0, 0.0), ellipsoid_grid(&pose)] {
+        let all = measure(&g, &ALL, &p).expect("measure");
+        // roundness first (the surface is extracted), then the rest reuse it
+        let mut m = Measurement::new(&g, &p).expect("new");
+        let r = m.get(&[Descriptor::Roundness]).expect("roundness");
+        let rest = m.get(&ALL).expect("rest");
+        // volume-type first (a separate pass), then the surface descriptors
+        let mut m2 = Measurement::owned(g.clone(), &p).expect("owned");
+        let v = m2.get(&[Descriptor::Volume]).expect("volume");
+        let rest2 = m2.get(&ALL).expect("rest");
+        let i_r = ALL
+            .iter()
+            .position(|d| *d == Descriptor::Roundness)
+            .expect("R");
+        let i_v = ALL
+            .iter()
+            .position(|d| *d == Descriptor::Volume)
+            .expect("V");
+        assert_eq!(r[0].to_bits(), all[i_r].to_bits());
+        assert_eq!(v[0].to_bits(), all[i_v].to_bits());
+        for (d, ((a, b), c)) in ALL.iter().zip(all.iter().zip(&rest).zip(&rest2)) {
+            assert_eq!(a.to_bits(), b.to_bits(), "{d:?}");
+            assert_eq!(a.to_bits(), c.to_bits(), "{d:?}");
+        }
+        let (_, frame) = measure_with_frame(&g, &[Descriptor::Volume], &p).expect("frame");
+        assert_eq!(m.frame().expect("frame"), frame);
+        assert_eq!(m2.into_grid(), g);
+    }
+    // bad input: invalid params, every node inside
+    let inside = Grid::from_fn(
+        levelset::GridSpec::cube(9, -1.0, 1.0).expect("spec"),
+        |_| -1.0,
+    )
+    .expect("grid");
+    assert!(matches!(
+        Measurement::new(&inside, &p),
+        Err(Error::LevelSet { .. })
+    ));
+    let bad = MeasureParams {
+        corner_margin: f64::NAN,
+        ..p
+    };
+    assert!(Measurement::new(&sphere_grid(), &bad).is_err());
+}
