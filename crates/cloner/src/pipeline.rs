@@ -27,11 +27,14 @@
 //!    V/S test `|V/S − V/S*| ≤ tol · V/S*` (Medina 2018, §2.4);
 //! 5. **rasterisation** of accepted candidates (only if a level set or DNA
 //!    was asked for) through `levelset::Grid::from_star`;
-//! 6. **DNA** of the level set through `morph_dna::measure` (only if asked
+//! 6. **DNA** of the level set through a `morph_dna::Measurement` (only if asked
 //!    for, or if `roundness_tolerance` is set: then a clone whose measured
 //!    roundness misses its target by more than that is rejected too, which
 //!    removes the scatter between the cheap surface roundness and the
 //!    level-set one at the price of rasterising the rejected candidates).
+//!    The roundness is measured first, alone; an accepted clone's other
+//!    descriptors reuse the surface it extracted (no second pass over the
+//!    grid; the same values as measuring them alone).
 //!    With `roundness_repairs` > 0 a miss first re-steers the candidate: the
 //!    same raw field is polished again toward a surface roundness moved
 //!    against the miss (divided by the steering map's slope), then stages

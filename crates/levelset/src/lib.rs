@@ -16,7 +16,10 @@
 //!   without), [`Grid::area`], [`Grid::mass_properties`]
 //!   ([`MassProperties::principal`]), [`Grid::bounding_box`], [`Grid::inscribed_sphere`],
 //!   [`Grid::equivalent_diameter`].
-//! * [`Grid::marching_cubes`] → [`TriMesh`] (closed, oriented, shared vertices).
+//! * [`Grid::marching_cubes`] → [`TriMesh`] (closed, oriented, shared vertices);
+//!   [`Grid::surface`] → [`Surface`] (the mesh and the cells it crosses), from which
+//!   [`Grid::mass_properties_of`] integrates without walking the grid again (bit for bit
+//!   [`Grid::mass_properties`]).
 //! * LS-DEM contact: [`Body`], [`contact()`] / [`contact_into`] → [`NodeContact`].
 //! * [`io`]: LS-DEM morph files, LAMMPS LSDEM grid files, VTK structured points, STL.
 //!

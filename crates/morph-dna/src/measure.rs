@@ -8,7 +8,10 @@
 //! (`levelset::Grid::mass_properties`); extents, convexity and roundness
 //! need the marching-cubes surface; roundness needs curvatures (nodal
 //! Hessians computed once per node) and the inscribed sphere; convexity the
-//! exact convex hull of the surface vertices.
+//! exact convex hull of the surface vertices. When the surface is extracted
+//! anyway, the integration runs over its mesh instead of a second pass over
+//! the grid (`levelset::Grid::mass_properties_of`: the same values bit for
+//! bit). [`Measurement`] keeps all of these between requests.
 //!
 //! # Design choices the seed leaves open
 //!
