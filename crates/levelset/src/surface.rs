@@ -456,7 +456,7 @@ impl Grid {
     }
 
     /// [`Grid::marching_cubes`] together with the cells the surface crosses: what
-    /// [`Surface::mass_properties`] needs to integrate over the extracted mesh instead of
+    /// [`Grid::mass_properties_of`] needs to integrate over the extracted mesh instead of
     /// walking the grid again (the same values bit for bit as [`Grid::mass_properties`]).
     pub fn surface(&self) -> Surface {
         with_closed_values(self, |spec, values| {
@@ -514,7 +514,7 @@ fn fingerprint(spec: &GridSpec, values: &[f64], cells: &[[u32; 3]]) -> u64 {
 }
 
 /// The zero surface of a grid extracted once ([`Grid::surface`]): its triangle mesh and the
-/// grid cells it crosses. [`Surface::mass_properties`] integrates over the mesh (no second
+/// grid cells it crosses. [`Grid::mass_properties_of`] integrates over the mesh (no second
 /// pass over the grid), bit for bit as [`Grid::mass_properties`].
 #[derive(Debug, Clone)]
 pub struct Surface {
