@@ -200,7 +200,7 @@ impl Grid {
     /// [`Grid::mass_properties`] from a [`Surface`] extracted from this grid
     /// ([`Grid::surface`]): the integrals over its mesh and the sharp-feature corrections
     /// of its crossed cells, without walking the grid again (the same values bit for bit;
-    /// about half the cost when the mesh is needed anyway).
+    /// on a 45³ cloned grain 10.9M instead of 13.4M instructions: the walk is skipped).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] if `surface` was not extracted from this grid (another
