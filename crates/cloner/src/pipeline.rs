@@ -261,7 +261,6 @@ impl RunStats {
     }
 }
 
-/// [`DNA`] without the roundness (index 2), in order.
 /// A clone's level set, alone or inside the measurement that holds its
 /// surface and measured descriptors.
 enum Held {
@@ -816,15 +815,17 @@ impl CloneModel {
                     // the roundness and the surface are reused when the check
                     // measured them
                     let m = match held {
-                        Held::Measured(m) => Ok(*m),
-                        Held::Grid(g) => Measurement::owned(g, &MeasureParams::default()),
+                        Held::Measured(m) => Ok(m),
+                        Held::Grid(g) => {
+                            Measurement::owned(g, &MeasureParams::default()).map(Box::new)
+                        }
                     };
                     let d = m.and_then(|mut m| m.get(&DNA).map(|d| (d, m)));
                     stats.times.measure_ns += clock.now_ns() - t1;
                     match d {
                         Ok((d, m)) => {
                             dna = Some(d);
-                            Held::Measured(Box::new(m))
+                            Held::Measured(m)
                         }
                         Err(_) => {
                             stats.rejections.degenerate += 1;

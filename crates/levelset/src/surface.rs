@@ -83,16 +83,8 @@ const EDGE_SLOT: [u8; 64] = {
     t
 };
 
-#[inline]
-fn corner_vec(c: u8) -> Vector3<f64> {
-    Vector3::new(
-        f64::from(c & 1),
-        f64::from((c >> 1) & 1),
-        f64::from((c >> 2) & 1),
-    )
-}
-
-/// [`corner_vec`] of every corner mask (a lookup instead of three integer conversions).
+/// The unit-cube corner of every corner mask (x = 1, y = 2, z = 4): a lookup instead of
+/// three integer conversions per vertex.
 const CORNERS: [[f64; 3]; 8] = {
     let mut t = [[0.0; 3]; 8];
     let mut c = 0;
@@ -104,7 +96,7 @@ const CORNERS: [[f64; 3]; 8] = {
 };
 
 #[inline]
-fn corner_of(c: u8) -> Vector3<f64> {
+fn corner_vec(c: u8) -> Vector3<f64> {
     let [x, y, z] = CORNERS[usize::from(c & 7)];
     Vector3::new(x, y, z)
 }
@@ -335,7 +327,7 @@ pub(crate) fn walk<S: Sink>(spec: &GridSpec, values: &[f64], sink: &mut S) {
                         // from the edge's own start node, so that every cell sharing the
                         // edge computes the same point bit for bit (the integrals over the
                         // walk and over the extracted mesh agree exactly)
-                        let p = spec.node(gi, gj, gk) + (h * tpar) * corner_of(d);
+                        let p = spec.node(gi, gj, gk) + (h * tpar) * corner_vec(d);
                         sink.vertex(gi, gj, gk, d, p)
                     };
                     let Some((&first_slot, rest)) = used.split_first() else {
@@ -537,7 +529,7 @@ impl Surface {
         self.mesh
     }
 
-    /// The cells crossed by the surface, in walk order, and the fingerprint.
+    /// The cells crossed by the surface, in walk order.
     pub(crate) fn cells(&self) -> &[[u32; 3]] {
         &self.cells
     }

@@ -136,6 +136,23 @@ fn shards_together_equal_the_unsharded_run() {
     assert_eq!(all.clones, joined);
 }
 
+/// Runs clones `0..n` on 1 and on 2 threads, asserts both runs identical
+/// (clones and statistics) and every clone within `tol` of its roundness
+/// target on the level set; returns the run.
+fn checked_run_on_1_and_2_threads(model: &CloneModel, n: u64, tol: f64) -> Run {
+    let b = in_pool(1, || model.run(0..n, Hooks::default()).expect("run"));
+    let b2 = in_pool(2, || model.run(0..n, Hooks::default()).expect("run"));
+    // deterministic for any thread count
+    assert_eq!(b.clones, b2.clones);
+    assert_eq!(b.stats, b2.stats);
+    // every clone still passes the level-set check
+    for c in &b.clones {
+        let measured = c.dna.as_ref().expect("dna")[2];
+        assert!((measured - c.targets.roundness).abs() <= tol);
+    }
+    b
+}
+
 /// Golden digest of a seeded run: guards the whole pipeline (targets,
 /// radii, polishing, quality control, rasterisation, DNA) against silent
 /// changes of its random streams or numerics. Re-mint deliberately (print
@@ -466,16 +483,7 @@ fn roundness_repairs_keep_the_check_and_save_candidates() {
     )
     .expect("model");
     let a = without.run(0..6, Hooks::default()).expect("run");
-    let b = in_pool(1, || with.run(0..6, Hooks::default()).expect("run"));
-    let b2 = in_pool(2, || with.run(0..6, Hooks::default()).expect("run"));
-    // deterministic for any thread count
-    assert_eq!(b.clones, b2.clones);
-    assert_eq!(b.stats, b2.stats);
-    // every clone still passes the level-set check
-    for c in &b.clones {
-        let measured = c.dna.as_ref().expect("dna")[2];
-        assert!((measured - c.targets.roundness).abs() <= 0.02);
-    }
+    let b = checked_run_on_1_and_2_threads(&with, 6, 0.02);
     // repairs were tried, and they cut the measured-roundness rejections
     assert!(b.stats.roundness_repairs > 0);
     assert!(
@@ -522,14 +530,7 @@ fn roundness_predictions_keep_the_check_and_determinism() {
     )
     .expect("model");
     let a = without.run(0..8, Hooks::default()).expect("run");
-    let b = in_pool(1, || with.run(0..8, Hooks::default()).expect("run"));
-    let b2 = in_pool(2, || with.run(0..8, Hooks::default()).expect("run"));
-    assert_eq!(b.clones, b2.clones);
-    assert_eq!(b.stats, b2.stats);
-    for c in &b.clones {
-        let measured = c.dna.as_ref().expect("dna")[2];
-        assert!((measured - c.targets.roundness).abs() <= 0.02);
-    }
+    let b = checked_run_on_1_and_2_threads(&with, 8, 0.02);
     assert!(b.stats.roundness_predictions > 0);
     // (whether the passes save level sets depends on how well the
     // prediction fits the parents: on the Ottawa grains they halve the
