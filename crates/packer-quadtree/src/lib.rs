@@ -9,7 +9,11 @@
 //!   from halo intersections, feasibility, lowest-ordinate rule, front
 //!   removal, Eq. 3-1 size list), configured by [`PackParams`]
 //!   ([`BoundaryMode`], [`HaloMode`], [`FrontOrder`]); every choice the
-//!   seed leaves open is listed in the `packer` module docs;
+//!   seed leaves open is listed in the `packer` module docs. Presets:
+//!   [`PackParams::default`] (reproduces the seed's porosities),
+//!   [`PackParams::dense`] (densest, about twice the cost; narrow channels
+//!   and slots much denser) and [`PackParams::seed`] (the text's literal
+//!   configuration);
 //! * [`Grading`]: sieve curves with semi-log inverse-transform sampling
 //!   (§4.2.1), constant, uniform, mixtures (Table 4.1); [`estimate_count`]
 //!   (Eq. 3-1);
