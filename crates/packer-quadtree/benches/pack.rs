@@ -5,9 +5,10 @@
 //! 609 s and 240 s).
 //!
 //! The square runs with [`FrontOrder::Stack`]: the default
-//! [`FrontOrder::Best`] runs the stack and the sorted orders and keeps the
-//! stack packing on this case, so the timed packing is the one `validate`
-//! reports (Best costs the sum of both orders).
+//! [`FrontOrder::Best`] (three orders) and [`PackParams::dense`] (the same
+//! three with and without wall attraction) both keep exactly this stack
+//! packing on this case (same digest), so the timed packing is the one
+//! `validate` reports; the portfolios cost the sum of their runs.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use packer_quadtree::{
