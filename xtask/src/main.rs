@@ -5,7 +5,8 @@
 //! clone` writes clones with the calibrated configuration; `cargo xtask
 //! validate [--filter PATTERN] [--report DIR] [--fast]` runs the reference
 //! cases of the `validate` crate, prints the result table and exits non-zero
-//! on failure; `cargo xtask dna` and `convergence` write generated tables.
+//! on failure; `cargo xtask pack` packs a 2D domain with disks and writes it
+//! for DEM tools; `cargo xtask dna` and `convergence` write generated tables.
 //! The tidy checks of the workspace are `#[test]`s in `tidy.rs`, run by
 //! `cargo test`.
 //!
@@ -21,6 +22,7 @@ mod calibrate;
 mod clone_cmd;
 mod convergence;
 mod dna;
+mod pack_cmd;
 mod svg;
 mod validate_cmd;
 
@@ -49,6 +51,9 @@ enum Command {
     /// Measure the morphological DNA of every shipped real grain into
     /// `fixtures/dna/` (`--check` verifies the committed table).
     Dna(dna::Dna),
+    /// Pack a 2D domain with disks (Pinto 2009's advancing front) and write
+    /// CSV, VTU (ParaView), LIGGGHTS/LAMMPS data, Yade text and SVG.
+    Pack(pack_cmd::Pack),
     /// Write the spherical-harmonic convergence table of the reference
     /// shapes (degree 1..30).
     Convergence(convergence::Convergence),
@@ -75,6 +80,7 @@ fn main() -> anyhow::Result<()> {
         Command::Validate(cmd) => cmd.run(),
         Command::Dna(cmd) => cmd.run(&workspace_root()),
         Command::Convergence(cmd) => cmd.run(&workspace_root()),
+        Command::Pack(cmd) => cmd.run(&workspace_root()),
     }
 }
 

@@ -1,0 +1,283 @@
+//! `cargo xtask pack`: pack a 2D domain with disks (Pinto 2009's advancing
+//! front, `packer-quadtree`) and write the packing for DEM tools: CSV, VTU
+//! (ParaView), LIGGGHTS/LAMMPS `read_data`, Yade text and an SVG picture.
+//! Every packing is checked by the independent overlap checker before it is
+//! written; a packing that fails the check is not written.
+//!
+//! Lengths are in mm (the seed's unit), as are the output coordinates.
+
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use clap::{Args, ValueEnum};
+use nalgebra::Point2;
+use packer_quadtree::{
+    Domain, Grading, PackParams, check_packing, pack_seeded, porosity, write_csv,
+    write_lammps_data, write_svg, write_vtu, write_yade,
+};
+
+/// Parameter presets of the packer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Preset {
+    /// `PackParams::default()`: reproduces the seed's porosities.
+    Default,
+    /// `PackParams::dense()`: the densest (about twice the cost).
+    Dense,
+    /// `PackParams::seed()`: the text's literal configuration.
+    Seed,
+}
+
+/// Output formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Output {
+    /// `packing.csv`: `x,y,r` per disk.
+    Csv,
+    /// `packing.vtu`: vertex cells with a radius array (ParaView).
+    Vtu,
+    /// `packing.data`: LIGGGHTS/LAMMPS `read_data`, `atom_style sphere`.
+    Lammps,
+    /// `packing.txt`: Yade `ymport.text` (`x y z r`).
+    Yade,
+    /// `packing.svg`: a picture of the domain and the disks.
+    Svg,
+}
+
+/// Flags of `cargo xtask pack`.
+#[derive(Debug, Args)]
+pub(crate) struct Pack {
+    /// Domain, in mm: `rect:W,H`, `slot:W,H` (fracture aperture W, height
+    /// H), `circle:R`, `trapezoid:H,BOTTOM,TOP`, or `polygon:x,y;x,y;...`.
+    #[arg(long, default_value = "rect:100,100")]
+    domain: String,
+    /// Grading, in mm: `pinto-3.4` (Pinto 2009, Table 3.4), `ap5`
+    /// (Table 4.1), `constant:D`, `uniform:MIN,MAX`, or
+    /// `sieve:SIZE:PASSING%,SIZE:PASSING%,...` (increasing sizes, 0 % first,
+    /// 100 % last).
+    #[arg(long, default_value = "pinto-3.4")]
+    grading: String,
+    /// Packer parameters.
+    #[arg(long, value_enum, default_value_t = Preset::Default)]
+    preset: Preset,
+    /// Seed of the size sampling (ChaCha8).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output formats (comma separated).
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "csv,vtu,lammps,yade,svg"
+    )]
+    formats: Vec<Output>,
+    /// Particle density for the LAMMPS file (in the file's mass/length³).
+    #[arg(long, default_value_t = 2.65e-3)]
+    density: f64,
+    /// Output directory.
+    #[arg(long, default_value = "target/packing")]
+    out: PathBuf,
+}
+
+fn numbers(s: &str, what: &str) -> anyhow::Result<Vec<f64>> {
+    s.split(',')
+        .map(|t| {
+            t.trim()
+                .parse::<f64>()
+                .with_context(|| format!("{what}: `{t}` is not a number"))
+        })
+        .collect()
+}
+
+fn exactly<const N: usize>(v: Vec<f64>, what: &str) -> anyhow::Result<[f64; N]> {
+    let n = v.len();
+    v.try_into()
+        .map_err(|_| anyhow::anyhow!("{what} takes {N} numbers, got {n}"))
+}
+
+/// Parses `--domain`.
+pub(crate) fn parse_domain(s: &str) -> anyhow::Result<Domain> {
+    let (kind, rest) = s.split_once(':').unwrap_or((s, ""));
+    Ok(match kind {
+        "rect" => {
+            let [width, height] = exactly(numbers(rest, "rect")?, "rect")?;
+            Domain::Rectangle { width, height }
+        }
+        "slot" => {
+            let [width, height] = exactly(numbers(rest, "slot")?, "slot")?;
+            Domain::FractureSlot { width, height }
+        }
+        "circle" => {
+            let [radius] = exactly(numbers(rest, "circle")?, "circle")?;
+            Domain::Circle { radius }
+        }
+        "trapezoid" => {
+            let [height, bottom, top] = exactly(numbers(rest, "trapezoid")?, "trapezoid")?;
+            Domain::Trapezoid {
+                height,
+                bottom,
+                top,
+            }
+        }
+        "polygon" => {
+            let mut vertices = Vec::new();
+            for v in rest.split(';') {
+                let [x, y] = exactly(numbers(v, "polygon vertex")?, "a polygon vertex")?;
+                vertices.push(Point2::new(x, y));
+            }
+            Domain::Polygon { vertices }
+        }
+        _ => bail!("unknown domain `{kind}` (rect, slot, circle, trapezoid, polygon)"),
+    })
+}
+
+/// Parses `--grading`.
+pub(crate) fn parse_grading(s: &str) -> anyhow::Result<Grading> {
+    let (kind, rest) = s.split_once(':').unwrap_or((s, ""));
+    let g = match kind {
+        "pinto-3.4" => Grading::pinto_table_3_4(),
+        "ap5" => Grading::pinto_ap5(),
+        "constant" => {
+            let [diameter] = exactly(numbers(rest, "constant")?, "constant")?;
+            Grading::Constant { diameter }
+        }
+        "uniform" => {
+            let [min, max] = exactly(numbers(rest, "uniform")?, "uniform")?;
+            Grading::Uniform { min, max }
+        }
+        "sieve" => {
+            let (mut sizes, mut passing) = (Vec::new(), Vec::new());
+            for pair in rest.split(',') {
+                let (d, p) = pair
+                    .split_once(':')
+                    .with_context(|| format!("sieve point `{pair}` is not SIZE:PASSING"))?;
+                sizes.push(
+                    d.trim()
+                        .parse::<f64>()
+                        .with_context(|| format!("sieve size `{d}`"))?,
+                );
+                passing.push(
+                    p.trim()
+                        .parse::<f64>()
+                        .with_context(|| format!("passing `{p}`"))?,
+                );
+            }
+            Grading::Sieve { sizes, passing }
+        }
+        _ => bail!("unknown grading `{kind}` (pinto-3.4, ap5, constant, uniform, sieve)"),
+    };
+    g.validate()?;
+    Ok(g)
+}
+
+impl Pack {
+    pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
+        let domain = parse_domain(&self.domain)?;
+        let grading = parse_grading(&self.grading)?;
+        let params = match self.preset {
+            Preset::Default => PackParams::default(),
+            Preset::Dense => PackParams::dense(),
+            Preset::Seed => PackParams::seed(),
+        };
+        if self.formats.contains(&Output::Lammps)
+            && !(self.density.is_finite() && self.density > 0.0)
+        {
+            bail!(
+                "--density must be positive and finite, got {}",
+                self.density
+            );
+        }
+        let start = Instant::now();
+        let p = pack_seeded(&domain, &grading, &params, self.seed)?;
+        let packed = start.elapsed().as_secs_f64();
+        let phi = porosity(&domain, &p.disks)?;
+        let rep = check_packing(&domain, &p.disks, 1e-9, 1e-9)?;
+        if !rep.is_clean() {
+            bail!(
+                "the independent checker rejects this packing ({} overlapping pairs, {} disks \
+                 outside): nothing written; please report it with the command line",
+                rep.overlapping_pairs.len(),
+                rep.outside.len()
+            );
+        }
+        let dir = root.join(&self.out);
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        for f in &self.formats {
+            let name = match f {
+                Output::Csv => "packing.csv",
+                Output::Vtu => "packing.vtu",
+                Output::Lammps => "packing.data",
+                Output::Yade => "packing.txt",
+                Output::Svg => "packing.svg",
+            };
+            let path = dir.join(name);
+            let w = BufWriter::new(
+                std::fs::File::create(&path)
+                    .with_context(|| format!("creating {}", path.display()))?,
+            );
+            match f {
+                Output::Csv => write_csv(&p.disks, w),
+                Output::Vtu => write_vtu(&p.disks, w),
+                Output::Lammps => write_lammps_data(&p.disks, self.density, w),
+                Output::Yade => write_yade(&p.disks, w),
+                Output::Svg => write_svg(&domain, &p.disks, w),
+            }
+            .with_context(|| format!("writing {}", path.display()))?;
+        }
+        println!(
+            "{} disks in {packed:.2} s ({:?} preset, seed {}): porosity {phi:.4}, coordination \
+             number {:.2}, min gap / d {:.2e}; written to {}",
+            p.disks.len(),
+            self.preset,
+            self.seed,
+            rep.coordination_number(p.disks.len()),
+            rep.min_relative_gap,
+            dir.display()
+        );
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{parse_domain, parse_grading};
+    use packer_quadtree::{Domain, Grading};
+
+    #[test]
+    fn domains_and_gradings_parse() {
+        assert_eq!(
+            parse_domain("slot:2.6,8000").expect("slot"),
+            Domain::FractureSlot {
+                width: 2.6,
+                height: 8000.0
+            }
+        );
+        assert!(matches!(
+            parse_domain("polygon:0,0;10,0;5,8").expect("polygon"),
+            Domain::Polygon { vertices } if vertices.len() == 3
+        ));
+        assert_eq!(
+            parse_grading("sieve:1.2:0,1.3:100").expect("sieve"),
+            Grading::Sieve {
+                sizes: vec![1.2, 1.3],
+                passing: vec![0.0, 100.0]
+            }
+        );
+    }
+
+    #[test]
+    fn bad_flags_are_errors() {
+        for d in ["rect:1", "rect:a,b", "hexagon:3", "polygon:0,0;1"] {
+            assert!(parse_domain(d).is_err(), "{d}");
+        }
+        for g in [
+            "uniform:2",
+            "sieve:1.3:0,1.2:100",
+            "sieve:1.2:10,1.3:100",
+            "constant:-1",
+            "weibull:1",
+        ] {
+            assert!(parse_grading(g).is_err(), "{g}");
+        }
+    }
+}
