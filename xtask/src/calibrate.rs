@@ -24,18 +24,18 @@
 //! reproduces the committed scores (runs are deterministic).
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Args;
 use cloner::{
-    Calibrated, CloneModel, Hooks, Params, Parents, Progress, RunStats, Scores, TABLES_4_5, score,
+    Calibrated, CloneModel, Hooks, Params, Parents, RunStats, Scores, TABLES_4_5, score,
 };
 use morph_dna::{Descriptor, DnaTable, GradingCurve, GradingWeight, SphericalMesh};
 
+use crate::parents::ParentArgs;
+use crate::progress;
 use crate::svg;
 
 /// Flags of `cargo xtask calibrate`.
@@ -68,7 +68,35 @@ pub(crate) struct Calibrate {
     /// Override the pilot clones of every configuration.
     #[arg(long)]
     pilot_clones: Option<usize>,
+    /// Where the parents come from (default: the embedded Ottawa grains).
+    #[command(flatten)]
+    source: ParentArgs,
+    /// Write the chosen configuration to this file (default: the committed
+    /// Ottawa fixture for the embedded parents, `REPORT/calibrated.ron` for
+    /// `--parents`); with `--check`, the calibration to re-score.
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+    /// Accuracy target: average mean error (%) at most this.
+    #[arg(long, default_value_t = 2.0)]
+    target_mean: f64,
+    /// Accuracy target: average standard-deviation error (%) at most this.
+    #[arg(long, default_value_t = 10.0)]
+    target_std: f64,
+    /// Accuracy target: every two-sample KS distance at most this.
+    #[arg(long, default_value_t = 0.08)]
+    target_ks: f64,
+    /// No progress bars.
+    #[arg(long)]
+    quiet: bool,
 }
+
+/// Relative cost of one candidate (targets, radii, polishing, quality
+/// control on the spherical mesh) against one level set (rasterisation and
+/// DNA), measured on the calibrated Ottawa configuration with stage times
+/// (`cargo xtask calibrate`, 2 threads, idle machine). Used to rank
+/// configurations by a deterministic cost: level sets + this × candidates
+/// per accepted clone.
+const CANDIDATE_COST: f64 = 0.03;
 
 const FIXTURE: &str = "fixtures/calibrated/gsc2-ottawa.ron";
 
@@ -213,45 +241,17 @@ fn sweep(seed: u64) -> Vec<Config> {
     out
 }
 
-fn progress_bar(label: &str) -> impl Fn(Progress) + Sync + '_ {
-    let last = Mutex::new(0u64);
-    // a bar on a terminal; quarter-way lines in a log
-    let tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    move |p: Progress| {
-        if !tty {
-            let q = (p.total / 4).max(1);
-            if p.done.is_multiple_of(q) || p.done == p.total {
-                eprintln!("  {label:<32} {}/{}", p.done, p.total);
-            }
-            return;
-        }
-        let step = (p.total / 50).max(1);
-        let mut l = last
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if p.done == p.total || p.done >= *l + step {
-            *l = p.done;
-            let filled = (40 * p.done / p.total.max(1)) as usize;
-            eprint!(
-                "\r  {label:<32} [{}{}] {}/{}",
-                "#".repeat(filled),
-                " ".repeat(40 - filled),
-                p.done,
-                p.total
-            );
-            if p.done == p.total {
-                eprintln!();
-            }
-            let _ = std::io::stderr().flush();
-        }
-    }
-}
-
-fn run_config(parents: &Parents, config: &Config, clones: u64) -> anyhow::Result<Outcome> {
+fn run_config(
+    parents: &Parents,
+    config: &Config,
+    clones: u64,
+    quiet: bool,
+) -> anyhow::Result<Outcome> {
     let model = CloneModel::fit(parents, &config.params)
         .with_context(|| format!("fitting {}", config.name))?;
     let clock = InstantClock(Instant::now());
-    let bar = progress_bar(&config.name);
+    let pb = progress::bar(&config.name, clones, quiet);
+    let bar = progress::clone_callback(&pb);
     let start = Instant::now();
     let run = model
         .run(
@@ -317,26 +317,30 @@ const SEED_ROWS: [&str; 4] = [
 fn report_md(
     outcomes: &[Outcome],
     best: usize,
-    parents: usize,
+    material: &Material,
     clones: u64,
     prep_s: f64,
 ) -> anyhow::Result<String> {
     let t4 = seed_table("gsc2018_table4_mean_error_pct.csv")?;
     let t5 = seed_table("gsc2018_table5_std_error_pct.csv")?;
-    let mut md =
-        String::from("# `cargo xtask calibrate`: GSC 2.0 clones of the Ottawa-sand parents\n\n");
+    let mut md = format!(
+        "# `cargo xtask calibrate`: GSC 2.0 clones of {}\n\n",
+        material.title
+    );
+    let parents = material.parents;
     let _ = writeln!(
         md,
-        "{parents} NIST/VCCTL Ottawa-sand parents (45³ level sets of their SH models, {prep_s:.1} s to prepare and measure), {clones} clones per configuration, DNA of every clone measured on its level set exactly like the parents. Errors are |clone − parent| / parent of the mean and of the standard deviation (Medina 2018, Tables 4–5, in %); KS is the two-sample Kolmogorov–Smirnov distance. Wall time on {} threads.\n",
+        "{parents} parents ({}, {prep_s:.1} s to prepare and measure), {clones} clones per configuration, DNA of every clone measured on its level set exactly like the parents. Errors are |clone − parent| / parent of the mean and of the standard deviation (Medina 2018, Tables 4–5, in %); KS is the two-sample Kolmogorov–Smirnov distance. Wall time on {} threads.\n",
+        material.description,
         rayon::current_num_threads()
     );
-    md.push_str("## Every configuration\n\n| configuration | seed trial | mean err AR / D / R / V/S (%) | avg | std err AR / D / R / V/S (%) | avg | KS AR / D / R / V/S | max KS | accepted/s | ms per clone (CPU) | acceptance |\n|---|---|---|---:|---|---:|---|---:|---:|---:|---:|\n");
+    md.push_str("## Every configuration\n\n| configuration | seed trial | mean err AR / D / R / V/S (%) | avg | std err AR / D / R / V/S (%) | avg | KS AR / D / R / V/S | max KS | accepted/s | ms per clone (CPU) | acceptance | level sets / clone | cost / clone |\n|---|---|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|\n");
     for o in outcomes {
         let s = &o.scores;
         let cpu_ms = o.stats.times.total_ns() as f64 * 1e-6 / o.stats.accepted.max(1) as f64;
         let _ = writeln!(
             md,
-            "| {}{} | {} | {:.2} / {:.2} / {:.2} / {:.2} | **{:.2}** | {:.2} / {:.2} / {:.2} / {:.2} | **{:.2}** | {:.3} / {:.3} / {:.3} / {:.3} | {:.3} | {:.0} | {:.2} | {:.1} % |",
+            "| {}{} | {} | {:.2} / {:.2} / {:.2} / {:.2} | **{:.2}** | {:.2} / {:.2} / {:.2} / {:.2} | **{:.2}** | {:.3} / {:.3} / {:.3} / {:.3} | {:.3} | {:.0} | {:.2} | {:.1} % | {:.2} | {:.2} |",
             o.config.name,
             if std::ptr::eq(o, &outcomes[best]) {
                 " (chosen)"
@@ -361,7 +365,9 @@ fn report_md(
             s.ks_max,
             o.stats.accepted as f64 / o.wall_s,
             cpu_ms,
-            100.0 * o.stats.acceptance_rate()
+            100.0 * o.stats.acceptance_rate(),
+            o.stats.level_sets as f64 / o.stats.accepted.max(1) as f64,
+            meets_and_cost(o, [f64::INFINITY; 3]).1
         );
     }
     // Tables 4–5 beside the seed's
@@ -619,16 +625,90 @@ fn write_plots(
     Ok(())
 }
 
+/// What the parents are, for the report.
+struct Material {
+    /// e.g. "the Ottawa-sand parents".
+    title: String,
+    /// e.g. "NIST/VCCTL Ottawa sand, 45³ level sets of their SH models".
+    description: String,
+    parents: usize,
+}
+
+/// Whether a configuration meets the accuracy targets, and its deterministic
+/// cost (level sets + [`CANDIDATE_COST`] × candidates, per accepted clone).
+fn meets_and_cost(o: &Outcome, targets: [f64; 3]) -> (bool, f64) {
+    let s = &o.scores;
+    let meets = s.mean_error_avg_pct <= targets[0]
+        && s.std_error_avg_pct <= targets[1]
+        && s.ks_max <= targets[2];
+    let per = o.stats.accepted.max(1) as f64;
+    let cost = (o.stats.level_sets as f64 + CANDIDATE_COST * o.stats.attempts as f64) / per;
+    (meets, cost)
+}
+
 impl Calibrate {
+    /// The embedded Ottawa parents, or the user's.
+    fn parents(&self) -> anyhow::Result<(Parents, Material, f64)> {
+        let start = Instant::now();
+        match &self.source.parents {
+            None => {
+                eprintln!(
+                    "preparing the default parents: {} Ottawa-sand grains drawn at random from NIST's population (45³ level sets, DNA)…",
+                    "71"
+                );
+                let parents = validate::grains::ottawa_parents()?;
+                let material = Material {
+                    title: "the Ottawa-sand parents".into(),
+                    description: format!(
+                        "NIST/VCCTL Ottawa sand, a random sample of the population (`fixtures/grains/{}`), 45³ level sets of their SH models",
+                        validate::grains::DEFAULT_PARENTS
+                    ),
+                    parents: parents.len(),
+                };
+                Ok((parents, material, start.elapsed().as_secs_f64()))
+            }
+            Some(path) => {
+                let loaded = crate::parents::load(&self.source, path)?;
+                let summary = loaded.summary(path);
+                let format = loaded.format;
+                let (parents, _, dna_s) = crate::parents::measure(loaded)?;
+                eprintln!("{summary}, DNA {dna_s:.2} s.");
+                let material = Material {
+                    title: format!("`{}`", path.display()),
+                    description: format!("{summary}, DNA {dna_s:.2} s; format: {format:?}"),
+                    parents: parents.len(),
+                };
+                Ok((parents, material, start.elapsed().as_secs_f64()))
+            }
+        }
+    }
+
+    /// Where the chosen configuration goes (or is read from, with `--check`).
+    fn config_path(&self, root: &Path) -> Option<PathBuf> {
+        match (&self.out, &self.source.parents) {
+            (Some(p), _) => Some(p.clone()),
+            (None, None) => Some(root.join(FIXTURE)),
+            (None, Some(_)) => None,
+        }
+    }
+
     pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
         let start = Instant::now();
-        eprintln!("preparing the Ottawa-sand parents (45³ level sets, DNA)…");
-        let parents = validate::grains::ottawa_parents()?;
-        let prep_s = start.elapsed().as_secs_f64();
+        let (parents, material, prep_s) = self.parents()?;
         eprintln!("{} parents in {prep_s:.1} s", parents.len());
         if self.check {
             return self.check(root, &parents);
         }
+        for (name, v) in [
+            ("--target-mean", self.target_mean),
+            ("--target-std", self.target_std),
+            ("--target-ks", self.target_ks),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("{name} must be finite and positive, got {v}");
+            }
+        }
+        let targets = [self.target_mean, self.target_std, self.target_ks];
         let mut configs = sweep(self.seed);
         if let Some(only) = &self.only {
             let names: Vec<&str> = only.split(',').map(str::trim).collect();
@@ -650,8 +730,9 @@ impl Calibrate {
         }
         let mut outcomes = Vec::new();
         let mut failed = Vec::new();
+        let sweep_start = Instant::now();
         for c in &configs {
-            match run_config(&parents, c, self.clones) {
+            match run_config(&parents, c, self.clones, self.quiet) {
                 Ok(o) => outcomes.push(o),
                 Err(e) => {
                     eprintln!("  {}: FAILED: {e:#}", c.name);
@@ -659,32 +740,31 @@ impl Calibrate {
                 }
             }
         }
+        let sweep_s = sweep_start.elapsed().as_secs_f64();
         if outcomes.is_empty() {
             bail!("every configuration failed:\n{}", failed.join("\n"));
         }
-        // the accuracy targets first (average mean error <= 2 %,
+        // the accuracy targets first (by default average mean error <= 2 %,
         // average std error <= 10 %, every KS <= 0.08); among the
-        // configurations meeting them, the fewest level sets per accepted
-        // clone (the dominant cost, the same on every machine: beyond the
-        // targets, error differences of a few tenths of a point are sampling
-        // noise at 500 clones, cost differences are not); then the lowest sum
-        // of the two averages (the seed's criterion over both tables), which
-        // alone ranks the configurations that miss the targets
+        // configurations meeting them, the lowest deterministic cost per
+        // accepted clone (level sets + CANDIDATE_COST x candidates: the same
+        // on every machine; beyond the targets, error differences of a few
+        // tenths of a point are sampling noise at 500 clones, cost
+        // differences are not); then the lowest sum of the two averages (the
+        // seed's criterion over both tables), which alone ranks the
+        // configurations that miss the targets
         let best = outcomes
             .iter()
             .enumerate()
             .min_by(|(_, a), (_, b)| {
                 let key = |o: &Outcome| {
                     let s = &o.scores;
-                    let meets = s.mean_error_avg_pct <= 2.0
-                        && s.std_error_avg_pct <= 10.0
-                        && s.ks_max <= 0.08;
-                    let cost = if meets {
-                        o.stats.level_sets as f64 / o.stats.accepted.max(1) as f64
-                    } else {
-                        0.0
-                    };
-                    (!meets, cost, s.mean_error_avg_pct + s.std_error_avg_pct)
+                    let (meets, cost) = meets_and_cost(o, targets);
+                    (
+                        !meets,
+                        if meets { cost } else { 0.0 },
+                        s.mean_error_avg_pct + s.std_error_avg_pct,
+                    )
                 };
                 let (ka, kb) = (key(a), key(b));
                 ka.0.cmp(&kb.0)
@@ -694,62 +774,107 @@ impl Calibrate {
             .map_or(0, |(i, _)| i);
         let dir = root.join(&self.report);
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-        let mut md = report_md(&outcomes, best, parents.len(), self.clones, prep_s)?;
+        let mut md = report_md(&outcomes, best, &material, self.clones, prep_s)?;
+        let _ = writeln!(
+            md,
+            "\nParents: {}. Targets: average mean error ≤ {} %, average standard-deviation error ≤ {} %, every KS ≤ {}; {} of {} configurations meet them{}. Ranking cost: level sets + {CANDIDATE_COST} × candidates per accepted clone.",
+            material.description,
+            targets[0],
+            targets[1],
+            targets[2],
+            outcomes
+                .iter()
+                .filter(|o| meets_and_cost(o, targets).0)
+                .count(),
+            outcomes.len(),
+            if meets_and_cost(&outcomes[best], targets).0 {
+                ""
+            } else {
+                " (none does: the chosen configuration has the lowest error sum)"
+            }
+        );
         if !failed.is_empty() {
             md.push_str("\n## Configurations that failed\n\n");
             for f in &failed {
                 let _ = writeln!(md, "* {f}");
             }
         }
-        std::fs::write(dir.join("calibrate.md"), &md).context("writing calibrate.md")?;
-        std::fs::write(dir.join("calibrate.csv"), report_csv(&outcomes))
-            .context("writing calibrate.csv")?;
+        progress::write_atomic(&dir.join("calibrate.md"), md.as_bytes())?;
+        progress::write_atomic(&dir.join("calibrate.csv"), report_csv(&outcomes).as_bytes())?;
         write_plots(&dir, parents.dna(), &outcomes, best)?;
-        parents
-            .dna()
-            .write_csv(std::fs::File::create(dir.join("parents-dna.csv"))?)?;
-        outcomes[best]
-            .dna
-            .write_csv(std::fs::File::create(dir.join("clones-dna.csv"))?)?;
-        std::fs::write(dir.join("clones-steering.csv"), &outcomes[best].steering)
-            .context("writing clones-steering.csv")?;
-        println!("{md}");
-        if !self.no_fixture && self.only.is_none() {
-            let b = &outcomes[best];
-            let cal = Calibrated {
-                name: b.config.name.clone(),
-                params: b.config.params,
-                clones: self.clones,
-                parents: parents.len(),
-                scores: b.scores.clone(),
-                attempts: b.stats.attempts,
-            };
-            let text = cal.to_ron()?;
-            let path = root.join(FIXTURE);
-            std::fs::write(&path, text + "\n")
-                .with_context(|| format!("writing {}", path.display()))?;
-            println!("wrote {}", path.display());
+        let mut buf = Vec::new();
+        parents.dna().write_csv(&mut buf)?;
+        progress::write_atomic(&dir.join("parents-dna.csv"), &buf)?;
+        let mut buf = Vec::new();
+        outcomes[best].dna.write_csv(&mut buf)?;
+        progress::write_atomic(&dir.join("clones-dna.csv"), &buf)?;
+        progress::write_atomic(
+            &dir.join("clones-steering.csv"),
+            outcomes[best].steering.as_bytes(),
+        )?;
+        if !self.quiet {
+            println!("{md}");
         }
+        let b = &outcomes[best];
+        let cal = Calibrated {
+            name: b.config.name.clone(),
+            params: b.config.params,
+            clones: self.clones,
+            parents: parents.len(),
+            scores: b.scores.clone(),
+            attempts: b.stats.attempts,
+        };
+        let text = cal.to_ron()? + "\n";
+        let written = if self.no_fixture || (self.only.is_some() && self.out.is_none()) {
+            None
+        } else {
+            let path = self
+                .config_path(root)
+                .unwrap_or_else(|| dir.join("calibrated.ron"));
+            progress::write_atomic(&path, text.as_bytes())?;
+            Some(path)
+        };
         println!(
-            "report in {} ({:.1} s)",
+            "Calibrated {} parents: {} configurations × {} clones in {sweep_s:.1} s (parents {prep_s:.1} s); chosen `{}`: average mean error {:.2} %, average std error {:.2} %, max KS {:.3}, {:.0} accepted clones/s; report in {}{} ({:.1} s in all).",
+            parents.len(),
+            outcomes.len(),
+            self.clones,
+            b.config.name,
+            b.scores.mean_error_avg_pct,
+            b.scores.std_error_avg_pct,
+            b.scores.ks_max,
+            b.stats.accepted as f64 / b.wall_s,
             dir.display(),
+            written
+                .map(|p| format!(", configuration in {}", p.display()))
+                .unwrap_or_default(),
             start.elapsed().as_secs_f64()
         );
         Ok(())
     }
 
     fn check(&self, root: &Path, parents: &Parents) -> anyhow::Result<()> {
-        let path = root.join(FIXTURE);
+        let path = self.config_path(root).with_context(|| {
+            "--check with --parents needs --out FILE: the calibration to re-score"
+        })?;
+        let shown = path.strip_prefix(root).unwrap_or(&path).display().to_string();
         let text = std::fs::read_to_string(&path)
             .with_context(|| format!("reading {}", path.display()))?;
         let cal =
             Calibrated::from_ron(&text).with_context(|| format!("parsing {}", path.display()))?;
+        if cal.parents != parents.len() {
+            bail!(
+                "{shown} was calibrated on {} parents, these are {}",
+                cal.parents,
+                parents.len()
+            );
+        }
         let config = Config {
             name: cal.name.clone(),
             trial: None,
             params: cal.params,
         };
-        let o = run_config(parents, &config, cal.clones)?;
+        let o = run_config(parents, &config, cal.clones, self.quiet)?;
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.abs().max(b.abs()).max(1.0);
         let (a, b) = (&cal.scores, &o.scores);
         let same = o.stats.attempts == cal.attempts
@@ -764,7 +889,7 @@ impl Calibrate {
             && a.ks.iter().zip(&b.ks).all(|(x, y)| close(*x, *y));
         if !same {
             bail!(
-                "{FIXTURE} is stale: committed avg errors {:.4} % / {:.4} % ({} attempts), recomputed {:.4} % / {:.4} % ({} attempts); run `cargo xtask calibrate`",
+                "{shown} is stale: committed avg errors {:.4} % / {:.4} % ({} attempts), recomputed {:.4} % / {:.4} % ({} attempts); run `cargo xtask calibrate`",
                 a.mean_error_avg_pct,
                 a.std_error_avg_pct,
                 cal.attempts,
@@ -774,7 +899,7 @@ impl Calibrate {
             );
         }
         println!(
-            "{FIXTURE} reproduced: {} clones of `{}`, avg mean error {:.2} %, avg std error {:.2} %, max KS {:.3}, {:.0} accepted clones/s",
+            "{shown} reproduced: {} clones of `{}`, avg mean error {:.2} %, avg std error {:.2} %, max KS {:.3}, {:.0} accepted clones/s",
             cal.clones,
             cal.name,
             b.mean_error_avg_pct,

@@ -23,6 +23,8 @@ mod clone_cmd;
 mod convergence;
 mod dna;
 mod pack_cmd;
+mod parents;
+mod progress;
 mod svg;
 mod validate_cmd;
 

@@ -114,7 +114,8 @@ pub mod surface;
 pub use calibration::{Calibrated, Scores, score};
 pub use error::{Error, Result};
 pub use model::{
-    CloneModel, DNA, MIN_PARENTS, Parents, SteeringMap, TABLES_4_5, TARGETS, Targets, grid_from_sh,
+    CloneModel, DNA, MIN_PARENTS, Parents, SteeringMap, TABLES_4_5, TARGETS, Targets,
+    grid_from_mesh, grid_from_sh,
 };
 pub use output::{Format, write_grid};
 pub use params::{Outputs, Params, RadiiModel, Smoothing, TargetModel};

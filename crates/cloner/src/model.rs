@@ -841,3 +841,55 @@ pub fn grid_from_sh(
     )?;
     Ok(grid)
 }
+
+/// The level set of a closed triangle mesh of one grain (e.g. a Sand Atlas
+/// or LS-DEM STL): a cube of `resolution³` nodes spanning `±margin · r_max`
+/// about the mesh's volume centroid, `r_max` the farthest vertex from it —
+/// the construction of [`grid_from_sh`], so mesh and SH parents are
+/// rasterised alike — with the exact signed distance of the mesh at every
+/// node ([`Grid::from_mesh`]).
+///
+/// The mesh must be closed and outward oriented (see
+/// `levelset::TriMesh::prepare_closed`, which checks and repairs it).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a margin outside (1, 4];
+/// [`Error::DegenerateParent`] (index 0) for a mesh of non-positive or
+/// non-finite volume; level-set errors (an open mesh).
+pub fn grid_from_mesh(mesh: &levelset::TriMesh, resolution: usize, margin: f64) -> Result<Grid> {
+    if !(margin.is_finite() && margin > 1.0 && margin <= 4.0) {
+        return Err(Error::InvalidParameter {
+            name: "margin",
+            value: margin,
+            reason: "in (1, 4]",
+        });
+    }
+    // volume centroid by signed tetrahedra about the first vertex (translation
+    // invariant, so no cancellation from a far origin)
+    let v = mesh.vertices();
+    let degenerate = |reason: String| Error::DegenerateParent { index: 0, reason };
+    let o = v
+        .first()
+        .ok_or_else(|| degenerate("empty mesh".into()))?
+        .coords;
+    let (mut vol, mut c) = (0.0, nalgebra::Vector3::zeros());
+    for t in mesh.triangles() {
+        let (a, b, d) = (v[t[0]].coords - o, v[t[1]].coords - o, v[t[2]].coords - o);
+        let w = a.dot(&b.cross(&d)) / 6.0;
+        vol += w;
+        c += w * (a + b + d) / 4.0;
+    }
+    if !(vol.is_finite() && vol > 0.0) {
+        return Err(degenerate(format!(
+            "mesh volume {vol} (not closed, inverted or flat)"
+        )));
+    }
+    let centre = nalgebra::Point3::from(o + c / vol);
+    let r_max = v.iter().map(|p| (p - centre).norm()).fold(0.0f64, f64::max);
+    let spec = levelset::GridSpec::cube(resolution, -margin * r_max, margin * r_max)?;
+    let spec = levelset::GridSpec {
+        origin: spec.origin + centre.coords,
+        ..spec
+    };
+    Ok(Grid::from_mesh(spec, mesh)?)
+}
