@@ -28,6 +28,23 @@ impl TriMesh {
     /// [`Error::EmptyMesh`], [`Error::NonFiniteVertex`], [`Error::VertexIndexOutOfRange`],
     /// [`Error::DegenerateTriangle`].
     pub fn new(vertices: Vec<Point3<f64>>, triangles: Vec<[usize; 3]>) -> Result<Self> {
+        let mesh = Self::new_allowing_degenerate(vertices, triangles)?;
+        if let Some(triangle) = (0..mesh.triangles.len()).find(|&t| mesh.is_degenerate(t)) {
+            return Err(Error::DegenerateTriangle { triangle });
+        }
+        Ok(mesh)
+    }
+
+    /// As [`TriMesh::new`] but keeps degenerate triangles (a repeated vertex or zero area),
+    /// which mesh files often contain: the readers of [`crate::io`] build meshes this way,
+    /// and [`TriMesh::prepare_closed`] removes (and counts) them.
+    ///
+    /// # Errors
+    /// [`Error::EmptyMesh`], [`Error::NonFiniteVertex`], [`Error::VertexIndexOutOfRange`].
+    pub fn new_allowing_degenerate(
+        vertices: Vec<Point3<f64>>,
+        triangles: Vec<[usize; 3]>,
+    ) -> Result<Self> {
         if triangles.is_empty() {
             return Err(Error::EmptyMesh);
         }
@@ -47,16 +64,17 @@ impl TriMesh {
                     });
                 }
             }
-            let [a, b, c] = *tri;
-            let n = (vertices[b] - vertices[a]).cross(&(vertices[c] - vertices[a]));
-            if a == b || b == c || a == c || n.norm_squared().is_nan() || n.norm_squared() <= 0.0 {
-                return Err(Error::DegenerateTriangle { triangle: t });
-            }
         }
         Ok(Self {
             vertices,
             triangles,
         })
+    }
+
+    /// A repeated vertex index or an exactly zero (or non-finite) cross product.
+    fn is_degenerate(&self, t: usize) -> bool {
+        let [a, b, c] = self.triangles[t];
+        degenerate(&self.vertices, a, b, c)
     }
 
     pub(crate) fn from_parts_unchecked(
@@ -150,6 +168,363 @@ impl TriMesh {
         }
         Ok(across)
     }
+
+    /// Volume centroid: the volume-weighted mean of the centroids of the signed tetrahedra
+    /// spanned by each triangle and the centre of the bounding box (exact for a closed mesh
+    /// of either orientation).
+    ///
+    /// # Errors
+    /// [`Error::EmptyMesh`]; [`Error::ZeroVolume`] if |volume| ≤ 1e-10 · area^{3/2}.
+    pub fn centroid(&self) -> Result<Point3<f64>> {
+        if self.triangles.is_empty() {
+            return Err(Error::EmptyMesh);
+        }
+        let o = self.box_centre();
+        let mut six_v = 0.0;
+        let mut acc = Vector3::zeros();
+        for &[a, b, c] in &self.triangles {
+            let (pa, pb, pc) = (
+                self.vertices[a] - o,
+                self.vertices[b] - o,
+                self.vertices[c] - o,
+            );
+            let w = pa.dot(&pb.cross(&pc));
+            six_v += w;
+            acc += w * (pa + pb + pc);
+        }
+        let (volume, area) = (six_v / 6.0, self.area());
+        if !has_volume(volume, area) {
+            return Err(Error::ZeroVolume { volume, area });
+        }
+        Ok(o + acc / (4.0 * six_v))
+    }
+
+    /// Centre of the bounding box of the vertices (the origin if there are none).
+    fn box_centre(&self) -> Point3<f64> {
+        let mut b = Aabb::empty();
+        for p in &self.vertices {
+            b.grow(&p.coords);
+        }
+        if self.vertices.is_empty() {
+            Point3::origin()
+        } else {
+            Point3::from(0.5 * (b.lo + b.hi))
+        }
+    }
+
+    /// Turns a user's mesh into a closed, manifold, outward-oriented surface of one grain,
+    /// or says precisely why it is not one.
+    ///
+    /// Steps, in order:
+    /// 1. weld vertices with bit-identical positions (`-0.0 = 0.0`; the lowest index of a
+    ///    group stands for it, so errors name vertices of `self`);
+    /// 2. drop degenerate triangles (a repeated vertex after welding, or an exactly zero
+    ///    cross product);
+    /// 3. every undirected edge must belong to exactly two triangles: more →
+    ///    [`Error::NonManifoldEdge`], one → [`Error::OpenMesh`] (the lowest such edge and
+    ///    the counts);
+    /// 4. the triangles around every vertex must form one fan (a disk), else
+    ///    [`Error::NonManifoldVertex`];
+    /// 5. one edge-connected component, else [`Error::SeveralComponents`] (one grain per mesh);
+    /// 6. orientation by breadth-first search over the edge adjacency from triangle 0; the
+    ///    minority orientation (ties: the class of triangle 0 wins) is the one counted as
+    ///    flipped; a one-sided surface is [`Error::NonOrientable`];
+    /// 7. the volume of the consistent mesh must not vanish ([`Error::ZeroVolume`] if
+    ///    |V| ≤ 1e-10 · area^{3/2}); a negative volume means the mesh faces inward.
+    ///
+    /// With [`Orientation::Repair`] the minority triangles are flipped and an inward mesh is
+    /// inverted, both reported in [`MeshRepair`]; with [`Orientation::Refuse`] either is an
+    /// error ([`Error::InconsistentOrientation`], [`Error::InwardOrientation`]). A mesh is
+    /// never inverted without saying so. The result keeps the referenced vertices in their
+    /// original order, renumbered densely, and the surviving triangles in their order; it
+    /// passes [`TriMesh::check_closed`] and has a positive [`TriMesh::signed_volume`].
+    ///
+    /// Self-intersections are not detected (a closed, oriented but self-intersecting mesh
+    /// passes, and its signed distance is then meaningless near the intersection).
+    ///
+    /// # Errors
+    /// As listed above; [`Error::EmptyMesh`] if no triangle survives step 2.
+    pub fn prepare_closed(&self, policy: Orientation) -> Result<(TriMesh, MeshRepair)> {
+        let v = &self.vertices;
+        let pos = |i: usize| [v[i].x, v[i].y, v[i].z];
+        let mut repair = MeshRepair::default();
+
+        // 1. Weld: sort by position (then index), map every vertex to the first of its group.
+        let key = |p: &Point3<f64>| {
+            [
+                (p.x + 0.0).to_bits(),
+                (p.y + 0.0).to_bits(),
+                (p.z + 0.0).to_bits(),
+            ]
+        };
+        let mut order: Vec<usize> = (0..v.len()).collect();
+        order.sort_unstable_by_key(|&i| (key(&v[i]), i));
+        let mut rep: Vec<usize> = (0..v.len()).collect();
+        for w in order.windows(2) {
+            if key(&v[w[0]]) == key(&v[w[1]]) {
+                rep[w[1]] = rep[w[0]];
+                repair.welded += 1;
+            }
+        }
+
+        // 2. Degenerate triangles.
+        let mut tris: Vec<[usize; 3]> = Vec::with_capacity(self.triangles.len());
+        let mut source: Vec<usize> = Vec::with_capacity(self.triangles.len());
+        for (t, tri) in self.triangles.iter().enumerate() {
+            let [a, b, c] = tri.map(|i| rep[i]);
+            if degenerate(v, a, b, c) {
+                repair.degenerate_removed += 1;
+            } else {
+                tris.push([a, b, c]);
+                source.push(t);
+            }
+        }
+        if tris.is_empty() {
+            return Err(Error::EmptyMesh);
+        }
+        let n = tris.len();
+
+        // 3. Edges: half-edge h = 3t + e runs from tris[t][e] to tris[t][(e + 1) % 3].
+        let start = |h: usize| tris[h / 3][h % 3];
+        let mut edges: Vec<(usize, usize, usize)> = Vec::with_capacity(3 * n);
+        for (t, tri) in tris.iter().enumerate() {
+            for e in 0..3 {
+                let (a, b) = (tri[e], tri[(e + 1) % 3]);
+                edges.push((a.min(b), a.max(b), 3 * t + e));
+            }
+        }
+        edges.sort_unstable();
+        let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(3 * n / 2);
+        let mut non_manifold: Option<(usize, usize, usize)> = None;
+        let mut non_manifold_edges = 0;
+        let mut boundary: Option<(usize, usize)> = None;
+        let mut boundary_edges = 0;
+        for group in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+            let (a, b, h) = group[0];
+            match group {
+                [_] => {
+                    boundary_edges += 1;
+                    boundary.get_or_insert((a, b));
+                }
+                [_, (_, _, g)] => pairs.push((h, *g)),
+                _ => {
+                    non_manifold_edges += 1;
+                    non_manifold.get_or_insert((a, b, group.len()));
+                }
+            }
+        }
+        if let Some((a, b, count)) = non_manifold {
+            return Err(Error::NonManifoldEdge {
+                a,
+                b,
+                pa: pos(a),
+                pb: pos(b),
+                count,
+                edges: non_manifold_edges,
+            });
+        }
+        if let Some((a, b)) = boundary {
+            return Err(Error::OpenMesh {
+                a,
+                b,
+                pa: pos(a),
+                pb: pos(b),
+                boundary_edges,
+            });
+        }
+
+        // 4. Vertex fans: corners (3t + i, at tris[t][i]) joined across shared edges; a
+        // manifold vertex has all its corners in one class.
+        let mut corners = UnionFind::new(3 * n);
+        let mut triangles_uf = UnionFind::new(n);
+        // Per half-edge: the triangle across it and whether both run the same way.
+        let mut across = vec![(0usize, false); 3 * n];
+        for &(h, g) in &pairs {
+            let next = |x: usize| 3 * (x / 3) + (x % 3 + 1) % 3;
+            let same = start(h) == start(g);
+            if same {
+                corners.union(h, g);
+                corners.union(next(h), next(g));
+            } else {
+                corners.union(h, next(g));
+                corners.union(next(h), g);
+            }
+            triangles_uf.union(h / 3, g / 3);
+            across[h] = (g / 3, same);
+            across[g] = (h / 3, same);
+        }
+        let mut fans: Vec<(usize, usize)> =
+            (0..3 * n).map(|c| (start(c), corners.find(c))).collect();
+        fans.sort_unstable();
+        fans.dedup();
+        for group in fans.chunk_by(|x, y| x.0 == y.0) {
+            if group.len() > 1 {
+                let vertex = group[0].0;
+                return Err(Error::NonManifoldVertex {
+                    vertex,
+                    position: pos(vertex),
+                    fans: group.len(),
+                });
+            }
+        }
+
+        // 5. One component.
+        let count = (0..n).filter(|&t| triangles_uf.find(t) == t).count();
+        if count > 1 {
+            return Err(Error::SeveralComponents { count });
+        }
+
+        // 6. Orientation classes by breadth-first search from triangle 0.
+        let mut flip: Vec<Option<bool>> = vec![None; n];
+        flip[0] = Some(false);
+        let mut queue = std::collections::VecDeque::from([0usize]);
+        while let Some(t) = queue.pop_front() {
+            let ft = flip[t].unwrap_or(false);
+            for h in 3 * t..3 * t + 3 {
+                let (u, same) = across[h];
+                let want = ft ^ same;
+                match flip[u] {
+                    None => {
+                        flip[u] = Some(want);
+                        queue.push_back(u);
+                    }
+                    Some(f) if f != want => {
+                        return Err(Error::NonOrientable {
+                            triangle: source[u],
+                        });
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+        let mut flip: Vec<bool> = flip.into_iter().map(|f| f.unwrap_or(false)).collect();
+        let mut flipped = flip.iter().filter(|&&f| f).count();
+        if 2 * flipped > n {
+            flip.iter_mut().for_each(|f| *f = !*f);
+            flipped = n - flipped;
+        }
+
+        // 7. Volume of the consistent mesh.
+        let o = self.box_centre();
+        let mut six_v = 0.0;
+        let mut area = 0.0;
+        for (tri, &f) in tris.iter().zip(&flip) {
+            let (pa, pb, pc) = (v[tri[0]] - o, v[tri[1]] - o, v[tri[2]] - o);
+            let w = pa.dot(&pb.cross(&pc));
+            six_v += if f { -w } else { w };
+            area += 0.5 * (pb - pa).cross(&(pc - pa)).norm();
+        }
+        let volume = six_v / 6.0;
+        if !has_volume(volume, area) {
+            return Err(Error::ZeroVolume { volume, area });
+        }
+        let inverted = volume < 0.0;
+        if policy == Orientation::Refuse {
+            if flipped > 0 {
+                return Err(Error::InconsistentOrientation {
+                    flipped,
+                    triangles: n,
+                });
+            }
+            if inverted {
+                return Err(Error::InwardOrientation { volume });
+            }
+        }
+        repair.flipped = flipped;
+        repair.inverted = inverted;
+
+        // Output: referenced vertices in their original order.
+        let mut index = vec![usize::MAX; v.len()];
+        for tri in &tris {
+            for &i in tri {
+                index[i] = 0;
+            }
+        }
+        let mut vertices = Vec::new();
+        for (i, slot) in index.iter_mut().enumerate() {
+            if *slot == 0 {
+                *slot = vertices.len();
+                vertices.push(v[i]);
+            }
+        }
+        repair.unreferenced = v.len() - repair.welded - vertices.len();
+        let triangles = tris
+            .iter()
+            .zip(&flip)
+            .map(|(tri, &f)| {
+                let [a, b, c] = tri.map(|i| index[i]);
+                if f ^ inverted { [a, c, b] } else { [a, b, c] }
+            })
+            .collect();
+        Ok((Self::from_parts_unchecked(vertices, triangles), repair))
+    }
+}
+
+/// A repeated vertex or an exactly zero (or non-finite) cross product.
+fn degenerate(v: &[Point3<f64>], a: usize, b: usize, c: usize) -> bool {
+    let n2 = (v[b] - v[a]).cross(&(v[c] - v[a])).norm_squared();
+    a == b || b == c || a == c || !(n2 > 0.0)
+}
+
+/// A closed surface encloses volume if |V| > 1e-10 · A^{3/2} (a sphere has 0.094 A^{3/2}).
+fn has_volume(volume: f64, area: f64) -> bool {
+    volume.abs() > 1e-10 * area.powf(1.5) && volume.is_finite()
+}
+
+/// Disjoint sets with path halving and union by index (deterministic roots: the smaller
+/// index of two roots becomes the root).
+struct UnionFind {
+    parent: Vec<usize>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        Self {
+            parent: (0..n).collect(),
+        }
+    }
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] != x {
+            self.parent[x] = self.parent[self.parent[x]];
+            x = self.parent[x];
+        }
+        x
+    }
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            let (lo, hi) = (ra.min(rb), ra.max(rb));
+            self.parent[hi] = lo;
+        }
+    }
+}
+
+/// How [`TriMesh::prepare_closed`] treats orientation problems.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Orientation {
+    /// Flip the triangles of the minority orientation and invert an inward mesh, and say so
+    /// in [`MeshRepair`].
+    #[default]
+    Repair,
+    /// Return [`Error::InconsistentOrientation`] or [`Error::InwardOrientation`] instead of
+    /// flipping anything.
+    Refuse,
+}
+
+/// What [`TriMesh::prepare_closed`] changed. Vertex counts add up:
+/// input vertices = output vertices + `welded` + `unreferenced`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MeshRepair {
+    /// Vertices merged into an earlier vertex at the bit-identical position.
+    pub welded: usize,
+    /// Vertices dropped because no (non-degenerate) triangle uses them.
+    pub unreferenced: usize,
+    /// Degenerate triangles removed (a repeated vertex after welding, or zero area).
+    pub degenerate_removed: usize,
+    /// Triangles flipped to agree with the majority orientation of their neighbours.
+    pub flipped: usize,
+    /// Whether the whole (consistent) mesh was inverted because it faced inward.
+    pub inverted: bool,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -255,8 +630,13 @@ impl MeshDistance {
     /// Prepares a closed mesh.
     ///
     /// # Errors
-    /// [`Error::NonClosedMesh`] if the mesh is not closed and consistently oriented.
+    /// [`Error::DegenerateTriangle`] (its normal is undefined); [`Error::NonClosedMesh`] if
+    /// the mesh is not closed and consistently oriented ([`TriMesh::prepare_closed`] makes
+    /// it so, or says why not).
     pub fn new(mesh: &TriMesh) -> Result<Self> {
+        if let Some(triangle) = (0..mesh.triangles.len()).find(|&t| mesh.is_degenerate(t)) {
+            return Err(Error::DegenerateTriangle { triangle });
+        }
         let across = mesh.check_closed()?;
         let v = &mesh.vertices;
         let nt = mesh.triangles.len();
@@ -429,7 +809,7 @@ impl Grid {
     /// bounded by the previous node's |distance| + h (the distance is 1-Lipschitz).
     ///
     /// # Errors
-    /// Invalid spec; [`Error::NonClosedMesh`] for an open or inconsistently oriented mesh.
+    /// Invalid spec; as [`MeshDistance::new`].
     pub fn from_mesh(spec: GridSpec, mesh: &TriMesh) -> Result<Self> {
         spec.validate()?;
         let md = MeshDistance::new(mesh)?;

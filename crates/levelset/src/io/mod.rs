@@ -94,6 +94,11 @@ impl<R: BufRead> Tokens<R> {
         }
     }
 
+    /// Drops the tokens left on the current line.
+    pub(crate) fn skip_rest_of_line(&mut self) {
+        self.pos = self.tokens.len();
+    }
+
     /// Next token or an error naming what was expected.
     pub(crate) fn expect(&mut self, what: &str) -> Result<String> {
         match self.next_token()? {
