@@ -1,19 +1,27 @@
 //! Readers and writers over `BufRead` / `Write`: LS-DEM morph files, LAMMPS LSDEM grid
-//! files, VTK legacy structured points (ParaView) and STL (binary and ASCII).
+//! files, VTK legacy structured points (ParaView), and surface meshes as STL (binary and
+//! ASCII) and Wavefront OBJ.
 //!
 //! Writers print floats with Rust's shortest round-trip representation (switching to
 //! exponent notation outside 1e-4 ≤ |x| < 1e15), so every text writer round-trips exactly.
 //! Readers never trust declared counts for allocation, and report the 1-based line of the
 //! first problem ([`crate::Error::Parse`]); binary STL errors report line 0 and a byte
 //! offset in the reason.
+//!
+//! Mesh readers return the mesh as the file has it (STL welded, since it has no shared
+//! vertices; degenerate facets kept). A user's grain goes through
+//! [`crate::TriMesh::prepare_closed`] next, which repairs or refuses orientation and
+//! names what is wrong with an open or non-manifold mesh; the caller adds the file name.
 
 mod lammps;
 mod morph;
+mod obj;
 mod stl;
 mod vtk;
 
 pub use lammps::{read_lammps, write_lammps};
 pub use morph::{MorphFile, read_morph, write_morph};
+pub use obj::{read_obj, write_obj};
 pub use stl::{read_stl, write_stl_ascii, write_stl_binary};
 pub use vtk::{read_vtk, write_vtk};
 
