@@ -380,8 +380,7 @@ impl TriMesh {
         let mut queue = std::collections::VecDeque::from([0usize]);
         while let Some(t) = queue.pop_front() {
             let ft = flip[t].unwrap_or(false);
-            for h in 3 * t..3 * t + 3 {
-                let (u, same) = across[h];
+            for &(u, same) in &across[3 * t..3 * t + 3] {
                 let want = ft ^ same;
                 match flip[u] {
                     None => {
@@ -463,7 +462,7 @@ impl TriMesh {
 /// A repeated vertex or an exactly zero (or non-finite) cross product.
 fn degenerate(v: &[Point3<f64>], a: usize, b: usize, c: usize) -> bool {
     let n2 = (v[b] - v[a]).cross(&(v[c] - v[a])).norm_squared();
-    a == b || b == c || a == c || !(n2 > 0.0)
+    a == b || b == c || a == c || n2.is_nan() || n2 <= 0.0
 }
 
 /// A closed surface encloses volume if |V| > 1e-10 · A^{3/2} (a sphere has 0.094 A^{3/2}).
