@@ -88,7 +88,7 @@ pub use nalgebra;
 pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};
 pub use grid::{Grid, GridSpec};
-pub use mesh::{MeshDistance, TriMesh};
+pub use mesh::{MeshDistance, MeshRepair, Orientation, TriMesh};
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
 pub use star::{
