@@ -745,24 +745,57 @@ impl MeshDistance {
     /// up the search (any bound ≥ the true distance gives the exact answer).
     pub fn signed_distance_bounded(&self, p: &Point3<f64>, bound: f64) -> f64 {
         let q = p.coords;
-        let mut best2 = if bound.is_finite() {
+        let best2 = if bound.is_finite() {
             bound * bound * (1.0 + 1e-9) + 1e-300
         } else {
             f64::INFINITY
         };
-        let mut best: Option<(usize, Vector3<f64>, Feature)> = None;
-        let mut stack: [usize; 128] = [0; 128];
-        let mut sp = 1usize;
-        stack[0] = 0;
+        match self.search(&q, best2, None) {
+            Some(hit) => self.signed(&q, hit),
+            // Bound was too small (only possible with a wrong bound): exact search.
+            None if bound.is_finite() => self.signed_distance_bounded(p, f64::INFINITY),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// Exact signed distance and the closest triangle (in the internal order), starting
+    /// from the exact distance to triangle `hint` as the bound: the closest triangle of a
+    /// neighbouring query point is usually the answer, so the search only has to prove it.
+    fn signed_distance_from(&self, q: &Vector3<f64>, hint: usize) -> (f64, usize) {
+        let hint = hint.min(self.a.len().saturating_sub(1));
+        let (cp, f) = closest_on_triangle(q, &self.a[hint], &self.b[hint], &self.c[hint]);
+        let d2 = (q - cp).norm_squared();
+        let hit = self
+            .search(q, d2, Some((hint, cp, f)))
+            .unwrap_or((hint, cp, f));
+        (self.signed(q, hit), hit.0)
+    }
+
+    /// Depth-first nearest-triangle search, nearer child first, boxes farther than the best
+    /// squared distance so far pruned when pushed and when popped.
+    fn search(
+        &self,
+        q: &Vector3<f64>,
+        mut best2: f64,
+        mut best: Option<(usize, Vector3<f64>, Feature)>,
+    ) -> Option<(usize, Vector3<f64>, Feature)> {
+        let mut stack: [(usize, f64); 128] = [(0, 0.0); 128];
+        let mut sp = 0usize;
+        let root = self.nodes.first()?.bounds.dist2(q);
+        if root <= best2 {
+            stack[0] = (0, root);
+            sp = 1;
+        }
         while sp > 0 {
             sp -= 1;
-            let node = &self.nodes[stack[sp]];
-            if node.bounds.dist2(&q) > best2 {
+            let (ni, d) = stack[sp];
+            if d > best2 {
                 continue;
             }
+            let node = &self.nodes[ni];
             if node.count > 0 {
                 for t in node.start..node.start + node.count {
-                    let (cp, f) = closest_on_triangle(&q, &self.a[t], &self.b[t], &self.c[t]);
+                    let (cp, f) = closest_on_triangle(q, &self.a[t], &self.b[t], &self.c[t]);
                     let d2 = (q - cp).norm_squared();
                     if d2 <= best2 {
                         best2 = d2;
@@ -771,54 +804,68 @@ impl MeshDistance {
                 }
             } else if sp + 2 <= stack.len() {
                 let (l, r) = (node.start, node.start + 1);
-                let (dl, dr) = (
-                    self.nodes[l].bounds.dist2(&q),
-                    self.nodes[r].bounds.dist2(&q),
-                );
+                let (dl, dr) = (self.nodes[l].bounds.dist2(q), self.nodes[r].bounds.dist2(q));
                 // Visit the nearer child first (pushed last).
-                if dl < dr {
-                    stack[sp] = r;
-                    stack[sp + 1] = l;
+                let (near, far) = if dl < dr {
+                    ((l, dl), (r, dr))
                 } else {
-                    stack[sp] = l;
-                    stack[sp + 1] = r;
-                }
-                sp += 2;
-            }
-        }
-        match best {
-            Some((t, cp, f)) => {
-                let n = match f {
-                    Feature::Face => self.normals[t][0],
-                    Feature::Edge(e) => self.normals[t][1 + e],
-                    Feature::Vertex(v) => self.normals[t][4 + v],
+                    ((r, dr), (l, dl))
                 };
-                let d = (q - cp).norm();
-                if (q - cp).dot(&n) < 0.0 { -d } else { d }
+                for c in [far, near] {
+                    if c.1 <= best2 {
+                        stack[sp] = c;
+                        sp += 1;
+                    }
+                }
             }
-            // Bound was too small (only possible with a wrong bound): exact search.
-            None if bound.is_finite() => self.signed_distance_bounded(p, f64::INFINITY),
-            None => f64::INFINITY,
         }
+        best
+    }
+
+    /// The signed distance of a search result (sign from the pseudonormal of the closest
+    /// feature).
+    fn signed(&self, q: &Vector3<f64>, (t, cp, f): (usize, Vector3<f64>, Feature)) -> f64 {
+        let n = match f {
+            Feature::Face => self.normals[t][0],
+            Feature::Edge(e) => self.normals[t][1 + e],
+            Feature::Vertex(v) => self.normals[t][4 + v],
+        };
+        let d = (q - cp).norm();
+        if (q - cp).dot(&n) < 0.0 { -d } else { d }
     }
 }
 
 impl Grid {
-    /// Exact signed distance of a closed triangle mesh at every node. Each node's search is
-    /// bounded by the previous node's |distance| + h (the distance is 1-Lipschitz).
+    /// Exact signed distance of a closed triangle mesh at every node. Each node's search
+    /// starts from the closest triangle of the previous node (of the previous row or slice
+    /// at the start of a row): its exact distance is a tight bound, so the search mostly
+    /// confirms it.
     ///
     /// # Errors
     /// Invalid spec; as [`MeshDistance::new`].
     pub fn from_mesh(spec: GridSpec, mesh: &TriMesh) -> Result<Self> {
         spec.validate()?;
         let md = MeshDistance::new(mesh)?;
-        let h = spec.spacing;
-        let mut prev = f64::INFINITY;
-        Self::from_fn(spec, |p| {
-            let d = md.signed_distance_bounded(p, prev.abs() + h);
-            prev = d;
-            d
-        })
+        let [nx, ny, nz] = spec.dims;
+        let mut values = Vec::with_capacity(spec.len());
+        let (mut slice_start, mut row_start) = (0usize, 0usize);
+        for k in 0..nz {
+            for j in 0..ny {
+                let mut hint = if j == 0 { slice_start } else { row_start };
+                for i in 0..nx {
+                    let (d, t) = md.signed_distance_from(&spec.node(i, j, k).coords, hint);
+                    values.push(d);
+                    hint = t;
+                    if i == 0 {
+                        row_start = t;
+                        if j == 0 {
+                            slice_start = t;
+                        }
+                    }
+                }
+            }
+        }
+        Self::new(spec, values)
     }
 }
 

@@ -622,3 +622,68 @@ proptest! {
         let _ = m.centroid();
     }
 }
+
+/// The lumpy grain of the acceptance benchmark (radius 0.8 ± 0.17).
+fn lumpy(u: Vector3<f64>) -> f64 {
+    let theta = u.z.clamp(-1.0, 1.0).acos();
+    let phi = u.y.atan2(u.x);
+    0.8 + 0.12 * (3.0 * theta).sin() * (2.0 * phi).cos() + 0.05 * (5.0 * phi).sin() * theta.sin()
+}
+/// The lumpy grain as a latitude–longitude mesh of 4·m·(m − 1) triangles.
+fn lumpy_mesh(m: usize) -> TriMesh {
+    let seg = 2 * m;
+    let point = |theta: f64, phi: f64| {
+        let u = Vector3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        );
+        Point3::from(lumpy(u) * u)
+    };
+    let mut v = vec![point(0.0, 0.0)];
+    for i in 1..m {
+        let theta = std::f64::consts::PI * i as f64 / m as f64;
+        for j in 0..seg {
+            v.push(point(theta, std::f64::consts::TAU * j as f64 / seg as f64));
+        }
+    }
+    let south = v.len();
+    v.push(point(std::f64::consts::PI, 0.0));
+    let at = |i: usize, j: usize| 1 + (i - 1) * seg + j % seg;
+    let mut t = Vec::new();
+    for j in 0..seg {
+        t.push([0, at(1, j), at(1, j + 1)]);
+        t.push([south, at(m - 1, j + 1), at(m - 1, j)]);
+        for i in 1..m - 1 {
+            t.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            t.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    TriMesh::new(v, t)
+        .expect("mesh")
+        .prepare_closed(Orientation::Refuse)
+        .expect("c")
+        .0
+}
+/// `Grid::from_mesh` (searches seeded with the neighbour's closest triangle) agrees with
+/// unbounded exact queries at every node, on both sides of a lumpy, non-convex grain.
+#[test]
+fn from_mesh_equals_unbounded_queries() {
+    let mesh = lumpy_mesh(16);
+    let c = mesh.centroid().expect("centroid");
+    let spec = GridSpec::around_points(mesh.vertices(), c, 21, 1.1).expect("spec");
+    let g = Grid::from_mesh(spec, &mesh).expect("grid");
+    let md = MeshDistance::new(&mesh).expect("distance");
+    let [nx, ny, nz] = spec.dims;
+    let mut inside = 0;
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let exact = md.signed_distance(&spec.node(i, j, k));
+                assert_abs_diff_eq!(g.at(i, j, k), exact, epsilon = 1e-12);
+                inside += usize::from(exact < 0.0);
+            }
+        }
+    }
+    assert!(inside > 500 && inside < nx * ny * nz / 2, "{inside}");
+}
