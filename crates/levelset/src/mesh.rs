@@ -1,5 +1,6 @@
-//! Closed triangle meshes and their exact signed distance.
+//! Closed triangle meshes, their preparation as one grain, and their exact signed distance.
 //!
+//! # Distance
 //! The distance is the exact Euclidean distance to the closest triangle (closest point on
 //! a triangle: Ericson 2005, *Real-Time Collision Detection*, Sec. 5.1.5), found with a
 //! bounding-volume hierarchy of axis-aligned boxes (median split on the longest axis,
@@ -7,6 +8,47 @@
 //! closest feature — face, edge or vertex — which is provably correct for closed, consistently
 //! oriented meshes (Bærentzen & Aanæs 2005, IEEE TVCG 11, doi:10.1109/TVCG.2005.49, Thm. 1).
 //! Meshes that are not closed 2-manifolds with consistent orientation are rejected.
+//! [`Grid::from_mesh`] seeds every node's search with the closest triangle of its
+//! neighbour, whose exact distance is a tight bound; the search then only proves it. Far
+//! from a finely meshed surface that proof still visits many boxes (all those closer than
+//! the answer), which dominates the cost of a 45³ grid; the values are exact everywhere
+//! rather than exact in a band and propagated beyond it.
+//!
+//! # User meshes
+//! A grain scanned or exported by someone else (STL, OBJ: [`crate::io`]) is a triangle
+//! soup until [`TriMesh::prepare_closed`] has welded duplicated vertices, dropped degenerate
+//! triangles and checked that the surface is one closed, edge- and vertex-manifold,
+//! orientable component of non-zero volume. Choices and reasons:
+//! * Welding is exact (bit-identical positions, `-0.0 = 0.0`): a tolerance would merge
+//!   genuinely distinct vertices of fine scans, and exporters duplicate vertices exactly.
+//! * Problems are errors that name the first offending edge or vertex (indices of the input
+//!   mesh and positions) and count all of them, so the user can find them in a viewer;
+//!   nothing is closed or cut silently.
+//! * Orientation is made consistent by a breadth-first search over the edge adjacency, and
+//!   the triangles of the minority orientation are the ones counted as flipped; the result
+//!   is then turned outward by the sign of its volume. [`Orientation::Repair`] reports both
+//!   ([`MeshRepair::flipped`], [`MeshRepair::inverted`]), [`Orientation::Refuse`] returns an
+//!   error instead: a mesh is never inverted silently.
+//! * One connected component per mesh, since a file holds one grain.
+//! * [`TriMesh::centroid`] and [`crate::GridSpec::around_points`] then place a grid about
+//!   the grain as the spherical-harmonic grains are placed (45³ nodes, margin 1.1).
+//!
+//! ```
+//! use levelset::io::read_obj;
+//! use levelset::{Grid, GridSpec, Orientation};
+//!
+//! // A tetrahedron exported with one face the wrong way round.
+//! let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 4 3\n";
+//! let soup = read_obj(obj.as_bytes())?;
+//! let (grain, repair) = soup.prepare_closed(Orientation::Repair)?;
+//! assert_eq!((repair.flipped, repair.inverted), (1, false));
+//! assert!(soup.prepare_closed(Orientation::Refuse).is_err());
+//! let centre = grain.centroid()?;
+//! let spec = GridSpec::around_points(grain.vertices(), centre, 21, 1.1)?;
+//! let grid = Grid::from_mesh(spec, &grain)?;
+//! assert!(grid.at(10, 10, 10) < 0.0);
+//! # Ok::<(), levelset::Error>(())
+//! ```
 
 use nalgebra::{Point3, Vector3};
 
