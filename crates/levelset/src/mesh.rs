@@ -671,10 +671,14 @@ impl MeshDistance {
     /// Prepares a closed mesh.
     ///
     /// # Errors
+    /// [`Error::EmptyMesh`] (possible for [`TriMesh::default`]);
     /// [`Error::DegenerateTriangle`] (its normal is undefined); [`Error::NonClosedMesh`] if
     /// the mesh is not closed and consistently oriented ([`TriMesh::prepare_closed`] makes
     /// it so, or says why not).
     pub fn new(mesh: &TriMesh) -> Result<Self> {
+        if mesh.triangles.is_empty() {
+            return Err(Error::EmptyMesh);
+        }
         if let Some(triangle) = (0..mesh.triangles.len()).find(|&t| mesh.is_degenerate(t)) {
             return Err(Error::DegenerateTriangle { triangle });
         }

@@ -51,6 +51,7 @@ pub(crate) struct Tokens<R> {
     buf: Vec<u8>,
     tokens: Vec<String>,
     pos: usize,
+    lossy: bool,
 }
 
 impl<R: BufRead> Tokens<R> {
@@ -62,7 +63,16 @@ impl<R: BufRead> Tokens<R> {
             buf: Vec::new(),
             tokens: Vec::new(),
             pos: 0,
+            lossy: false,
         }
+    }
+
+    /// Accepts lines that are not UTF-8, replacing invalid bytes by U+FFFD (for formats
+    /// whose free-text fields, such as an STL solid name, may be in another encoding; a
+    /// replaced byte inside a number still fails to parse).
+    pub(crate) fn lossy(mut self) -> Self {
+        self.lossy = true;
+        self
     }
 
     pub(crate) fn err(&self, reason: impl Into<String>) -> Error {
@@ -81,7 +91,11 @@ impl<R: BufRead> Tokens<R> {
             return Ok(None);
         }
         self.line += 1;
-        let s = std::str::from_utf8(&self.buf).map_err(|_| self.err("line is not valid UTF-8"))?;
+        let s = match std::str::from_utf8(&self.buf) {
+            Ok(s) => std::borrow::Cow::Borrowed(s),
+            Err(_) if self.lossy => String::from_utf8_lossy(&self.buf),
+            Err(_) => return Err(self.err("line is not valid UTF-8")),
+        };
         Ok(Some(s.trim_end_matches(['\n', '\r']).to_string()))
     }
 

@@ -121,8 +121,8 @@ pub(crate) fn weld(corners: Vec<Point3<f64>>, format: &'static str) -> Result<Tr
 /// whitespace-separated (any line breaks, CRLF included), the name after `solid` is the
 /// words on its line before the first `facet`/`endsolid`, the name after `endsolid` the
 /// rest of its line, numbers in any Rust float syntax (scientific
-/// notation included), facet normals are read but ignored (they may even be `nan`), and
-/// several `solid … endsolid` blocks are concatenated.
+/// notation included), facet normals are read but ignored (they may even be `nan`),
+/// names may be in any encoding, and several `solid … endsolid` blocks are concatenated.
 ///
 /// # Errors
 /// [`Error::Parse`] for malformed or truncated data (line number for ASCII, byte offset
@@ -209,7 +209,7 @@ fn read_binary(data: &[u8]) -> Result<TriMesh> {
 }
 
 fn read_ascii(data: &[u8]) -> Result<TriMesh> {
-    let mut t = Tokens::new(data, "stl");
+    let mut t = Tokens::new(data, "stl").lossy();
     let mut corners = Vec::new();
     let mut tok = t.expect("solid")?;
     while tok == "solid" {

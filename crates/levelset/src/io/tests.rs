@@ -327,6 +327,19 @@ fn ascii_stl_variants() {
     assert_eq!(m.vertices().len(), 4);
     m.check_closed().expect("closed");
     assert_abs_diff_eq!(m.signed_volume(), tet.signed_volume(), epsilon = 1e-15);
+    // A name in Latin-1 is harmless.
+    let latin1 = [
+        b"solid pi\xe8ce\n".as_slice(),
+        text.split_once('\n').expect("l").1.as_bytes(),
+    ]
+    .concat();
+    assert_eq!(
+        read_stl(latin1.as_slice())
+            .expect("latin-1 name")
+            .triangles()
+            .len(),
+        4
+    );
     // Two solids in one file are concatenated (and are then two components).
     let two = format!("{text}{}", text.replace("solid tet", "solid other"));
     let m2 = read_stl(two.as_bytes()).expect("two solids");

@@ -81,6 +81,10 @@ fn open_and_bad_meshes_are_rejected() {
         TriMesh::new(vec![], vec![]),
         Err(Error::EmptyMesh)
     ));
+    assert!(matches!(
+        MeshDistance::new(&TriMesh::default()),
+        Err(Error::EmptyMesh)
+    ));
     let spec = GridSpec::cube(5, -1.0, 1.0).expect("spec");
     assert!(matches!(
         Grid::from_mesh(spec, &open),
