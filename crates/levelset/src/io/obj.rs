@@ -110,7 +110,8 @@ fn parse_corner(tok: &str, line: usize) -> Result<i64> {
 /// # Errors
 /// [`Error::Parse`] with the line for: a malformed number or index, a non-finite
 /// coordinate, a face with fewer than 3 corners, an index 0 or out of range (positive or
-/// relative), free-form geometry or an unknown statement, or no faces at all; [`Error::Io`] if reading fails.
+/// relative), free-form geometry or an unknown statement, or no faces at all;
+/// [`Error::Io`] if reading fails.
 pub fn read_obj(mut r: impl BufRead) -> Result<TriMesh> {
     let mut vertices: Vec<Point3<f64>> = Vec::new();
     // Triangles with the line of their face; positive indices are checked at the end.
