@@ -601,6 +601,62 @@ proptest! {
         prop_assert_eq!(refused.is_ok(), k == 0);
     }
 
+    /// Random edits of a closed cube (flip, drop, duplicate or re-point a triangle, move a
+    /// vertex onto another) never panic; accepted results are closed, consistent and
+    /// outward, and a mesh with only flips is always accepted with the cube's volume.
+    #[test]
+    fn edited_cubes_never_panic(
+        edits in proptest::collection::vec((0usize..5, 0usize..12, 0usize..8), 0..6),
+    ) {
+        let cube = cube_mesh();
+        let mut v = cube.vertices().to_vec();
+        let mut t = cube.triangles().to_vec();
+        let mut only_flips = true;
+        for &(kind, i, x) in &edits {
+            let i = i % t.len().max(1);
+            if t.is_empty() {
+                break;
+            }
+            match kind {
+                0 => t[i].swap(0, 1),
+                1 => {
+                    t.remove(i);
+                    only_flips = false;
+                }
+                2 => {
+                    t.push(t[i]);
+                    only_flips = false;
+                }
+                3 => {
+                    t[i][x % 3] = x;
+                    only_flips = false;
+                }
+                _ => {
+                    v[x] = v[(x + 1) % 8];
+                    only_flips = false;
+                }
+            }
+        }
+        let Ok(m) = TriMesh::new_allowing_degenerate(v, t.clone()) else {
+            prop_assert!(t.is_empty());
+            return Ok(());
+        };
+        match m.prepare_closed(Orientation::Repair) {
+            Ok((p, r)) => {
+                p.check_closed().expect("closed and consistent");
+                prop_assert!(p.signed_volume() > 0.0);
+                prop_assert_eq!(p.vertices().len() + r.welded + r.unreferenced, 8);
+                prop_assert_eq!(p.triangles().len() + r.degenerate_removed, t.len());
+                MeshDistance::new(&p).expect("distance");
+            }
+            Err(e) => prop_assert!(!only_flips, "{e}"),
+        }
+        if only_flips {
+            let (p, _) = m.prepare_closed(Orientation::Repair).expect("flips are repaired");
+            prop_assert!((p.signed_volume() - 1.0).abs() < 1e-14);
+        }
+    }
+
     /// Arbitrary triangle soups never panic; whatever is accepted is closed, consistent,
     /// outward, and its counts add up.
     #[test]
