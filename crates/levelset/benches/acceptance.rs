@@ -1,9 +1,13 @@
 //! Acceptance benchmarks of issue 3 on 45³ grids: star build (incl. redistancing; default
 //! band build and the seed's full sweep),
-//! marching cubes, volume + area + inertia, contact of 1,000 nodes.
+//! marching cubes, volume + area + inertia, contact of 1,000 nodes; and the user-grain mesh
+//! path (`mesh_grain` group): `prepare_closed` and `Grid::from_mesh` on a 45³ grid with
+//! margin 1.1 for lumpy grains of ≈ 5k and ≈ 50k triangles.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use levelset::{Body, Grid, GridSpec, Redistance, Sphere, StarParams, contact_into};
+use levelset::{
+    Body, Grid, GridSpec, Orientation, Redistance, Sphere, StarParams, TriMesh, contact_into,
+};
 use nalgebra::{Isometry3, Point3, Unit, Vector3};
 use std::hint::black_box;
 
@@ -113,5 +117,64 @@ fn benches(c: &mut Criterion) {
     });
 }
 
-criterion_group!(acceptance, benches);
+/// The lumpy grain as a latitude–longitude mesh with `m` rings: 4·m·(m − 1) triangles
+/// (m = 36: 5040; m = 112: 49 728).
+fn lumpy_mesh(m: usize) -> TriMesh {
+    let seg = 2 * m;
+    let point = |theta: f64, phi: f64| {
+        let u = Vector3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        );
+        Point3::from(lumpy(Unit::new_unchecked(u)) * u)
+    };
+    let mut v = vec![point(0.0, 0.0)];
+    for i in 1..m {
+        let theta = std::f64::consts::PI * i as f64 / m as f64;
+        for j in 0..seg {
+            v.push(point(theta, std::f64::consts::TAU * j as f64 / seg as f64));
+        }
+    }
+    let south = v.len();
+    v.push(point(std::f64::consts::PI, 0.0));
+    let at = |i: usize, j: usize| 1 + (i - 1) * seg + j % seg;
+    let mut t = Vec::new();
+    for j in 0..seg {
+        t.push([0, at(1, j), at(1, j + 1)]);
+        t.push([south, at(m - 1, j + 1), at(m - 1, j)]);
+        for i in 1..m - 1 {
+            t.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            t.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let mesh = TriMesh::new(v, t).expect("mesh");
+    let (mesh, repair) = mesh.prepare_closed(Orientation::Refuse).expect("closed");
+    assert_eq!(repair, levelset::MeshRepair::default());
+    mesh
+}
+
+fn mesh_grain(c: &mut Criterion) {
+    let mut group = c.benchmark_group("mesh_grain");
+    group.sample_size(10);
+    for m in [36, 112] {
+        let mesh = lumpy_mesh(m);
+        let n = mesh.triangles().len();
+        let centre = mesh.centroid().expect("centroid");
+        let spec = GridSpec::around_points(mesh.vertices(), centre, 45, 1.1).expect("spec");
+        group.bench_function(format!("prepare_closed_{n}"), |b| {
+            b.iter(|| {
+                black_box(&mesh)
+                    .prepare_closed(Orientation::Repair)
+                    .expect("ok")
+            })
+        });
+        group.bench_function(format!("from_mesh_45_{n}"), |b| {
+            b.iter(|| Grid::from_mesh(spec, black_box(&mesh)).expect("grid"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(acceptance, benches, mesh_grain);
 criterion_main!(acceptance);

@@ -100,6 +100,89 @@ pub enum Error {
         /// Number of triangles using b→a.
         reverse: usize,
     },
+    /// An edge of a closed-mesh candidate is shared by more than two triangles.
+    #[error(
+        "mesh is not manifold: edge ({a}, {b}) from {pa:?} to {pb:?} is shared by {count} triangles ({edges} such edges)"
+    )]
+    NonManifoldEdge {
+        /// First vertex of the edge (the smaller index, numbering of the input mesh).
+        a: usize,
+        /// Second vertex of the edge.
+        b: usize,
+        /// Position of `a`.
+        pa: [f64; 3],
+        /// Position of `b`.
+        pb: [f64; 3],
+        /// Number of triangles sharing the edge (≥ 3).
+        count: usize,
+        /// Number of edges shared by more than two triangles.
+        edges: usize,
+    },
+    /// A closed-mesh candidate has boundary edges (edges of only one triangle): it has holes.
+    #[error(
+        "mesh is not closed: edge ({a}, {b}) from {pa:?} to {pb:?} belongs to one triangle only ({boundary_edges} boundary edges)"
+    )]
+    OpenMesh {
+        /// First vertex of the edge (the smaller index, numbering of the input mesh).
+        a: usize,
+        /// Second vertex of the edge.
+        b: usize,
+        /// Position of `a`.
+        pa: [f64; 3],
+        /// Position of `b`.
+        pb: [f64; 3],
+        /// Number of boundary edges.
+        boundary_edges: usize,
+    },
+    /// The triangles around a vertex form several fans instead of one disk (e.g. two
+    /// solids touching at a corner).
+    #[error(
+        "mesh is not manifold at vertex {vertex} at {position:?}: its triangles form {fans} separate fans"
+    )]
+    NonManifoldVertex {
+        /// Vertex index (numbering of the input mesh).
+        vertex: usize,
+        /// Its position.
+        position: [f64; 3],
+        /// Number of fans (≥ 2).
+        fans: usize,
+    },
+    /// A mesh that should hold one grain holds several disconnected surfaces.
+    #[error("mesh has {count} connected components; one grain per mesh is expected")]
+    SeveralComponents {
+        /// Number of edge-connected components.
+        count: usize,
+    },
+    /// No consistent orientation exists (a one-sided surface such as a Klein bottle).
+    #[error("mesh is not orientable: triangle {triangle} cannot be oriented consistently")]
+    NonOrientable {
+        /// Index of the triangle (input numbering) where the conflict was found.
+        triangle: usize,
+    },
+    /// Triangles disagree in orientation and repair was refused.
+    #[error(
+        "mesh orientation is inconsistent: {flipped} of {triangles} triangles would have to be flipped"
+    )]
+    InconsistentOrientation {
+        /// Number of triangles in the minority orientation.
+        flipped: usize,
+        /// Number of (non-degenerate) triangles.
+        triangles: usize,
+    },
+    /// A consistently oriented mesh faces inward (negative volume) and repair was refused.
+    #[error("mesh faces inward (signed volume {volume}); refusing to invert it")]
+    InwardOrientation {
+        /// Signed volume (negative).
+        volume: f64,
+    },
+    /// A closed mesh encloses no volume (flat, or negligible against its area).
+    #[error("mesh encloses zero volume (signed volume {volume}, area {area})")]
+    ZeroVolume {
+        /// Signed volume.
+        volume: f64,
+        /// Total area.
+        area: f64,
+    },
     /// A vertex coordinate is NaN or infinite.
     #[error("vertex {index} has a non-finite coordinate")]
     NonFiniteVertex {
@@ -129,7 +212,7 @@ pub enum Error {
     /// A file could not be parsed.
     #[error("{format} parse error at line {line}: {reason}")]
     Parse {
-        /// Format name (`"morph"`, `"lammps"`, `"vtk"`, `"stl"`).
+        /// Format name (`"morph"`, `"lammps"`, `"vtk"`, `"stl"`, `"obj"`).
         format: &'static str,
         /// 1-based line number (0 for binary data: see `reason`).
         line: usize,

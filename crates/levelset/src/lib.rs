@@ -9,7 +9,10 @@
 //!   via [`Grid::from_shape`]; [`Superellipsoid`] and any star-shaped radius function via
 //!   [`Grid::from_star`] (cube-map direction table, narrow-band second-order distances and a
 //!   closest-point interior, or the seed's full fast sweeping: [`StarParams`], [`Redistance`]);
-//!   closed triangle meshes via [`Grid::from_mesh`] ([`MeshDistance`]: BVH + pseudonormals);
+//!   closed triangle meshes via [`Grid::from_mesh`] ([`MeshDistance`]: BVH + pseudonormals),
+//!   users' grain meshes made closed, manifold and outward by [`TriMesh::prepare_closed`]
+//!   (policy [`Orientation`], report [`MeshRepair`]) and framed by [`TriMesh::centroid`] and
+//!   [`GridSpec::around_points`];
 //!   voxel images via [`Grid::from_voxels`] (exact EDT) and [`Grid::from_grayscale`];
 //!   [`Grid::reinitialise`] (fast sweeping).
 //! * Properties on request: [`Grid::volume`] (sharp-feature corrected; [`Grid::volume_linear`]
@@ -21,7 +24,8 @@
 //!   [`Grid::mass_properties_of`] integrates without walking the grid again (bit for bit
 //!   [`Grid::mass_properties`]).
 //! * LS-DEM contact: [`Body`], [`contact()`] / [`contact_into`] → [`NodeContact`].
-//! * [`io`]: LS-DEM morph files, LAMMPS LSDEM grid files, VTK structured points, STL.
+//! * [`io`]: LS-DEM morph files, LAMMPS LSDEM grid files, VTK structured points, STL
+//!   (binary and ASCII) and Wavefront OBJ meshes.
 //!
 //! # Example
 //! ```
@@ -57,6 +61,9 @@
 //!   stored at `i + nx·(j + ny·k)`.
 //! * Body frames: a [`Body`]'s grid and nodes share one frame; poses map body → world.
 //! * Properties are per unit density; lengths in the grid's units.
+//! * Meshes: triangles counter-clockwise seen from outside (positive
+//!   [`TriMesh::signed_volume`]); mesh errors name vertices and edges by index and
+//!   position, and the caller adds the file name.
 //!
 //! # References
 //! * Kawamoto, Andò, Viggiani, Andrade 2016, J. Mech. Phys. Solids 91,
@@ -88,7 +95,7 @@ pub use nalgebra;
 pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};
 pub use grid::{Grid, GridSpec};
-pub use mesh::{MeshDistance, TriMesh};
+pub use mesh::{MeshDistance, MeshRepair, Orientation, TriMesh};
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
 pub use star::{

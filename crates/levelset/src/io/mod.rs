@@ -1,19 +1,27 @@
 //! Readers and writers over `BufRead` / `Write`: LS-DEM morph files, LAMMPS LSDEM grid
-//! files, VTK legacy structured points (ParaView) and STL (binary and ASCII).
+//! files, VTK legacy structured points (ParaView), and surface meshes as STL (binary and
+//! ASCII) and Wavefront OBJ.
 //!
 //! Writers print floats with Rust's shortest round-trip representation (switching to
 //! exponent notation outside 1e-4 ≤ |x| < 1e15), so every text writer round-trips exactly.
 //! Readers never trust declared counts for allocation, and report the 1-based line of the
 //! first problem ([`crate::Error::Parse`]); binary STL errors report line 0 and a byte
 //! offset in the reason.
+//!
+//! Mesh readers return the mesh as the file has it (STL welded, since it has no shared
+//! vertices; degenerate facets kept). A user's grain goes through
+//! [`crate::TriMesh::prepare_closed`] next, which repairs or refuses orientation and
+//! names what is wrong with an open or non-manifold mesh; the caller adds the file name.
 
 mod lammps;
 mod morph;
+mod obj;
 mod stl;
 mod vtk;
 
 pub use lammps::{read_lammps, write_lammps};
 pub use morph::{MorphFile, read_morph, write_morph};
+pub use obj::{read_obj, write_obj};
 pub use stl::{read_stl, write_stl_ascii, write_stl_binary};
 pub use vtk::{read_vtk, write_vtk};
 
@@ -43,6 +51,7 @@ pub(crate) struct Tokens<R> {
     buf: Vec<u8>,
     tokens: Vec<String>,
     pos: usize,
+    lossy: bool,
 }
 
 impl<R: BufRead> Tokens<R> {
@@ -54,7 +63,16 @@ impl<R: BufRead> Tokens<R> {
             buf: Vec::new(),
             tokens: Vec::new(),
             pos: 0,
+            lossy: false,
         }
+    }
+
+    /// Accepts lines that are not UTF-8, replacing invalid bytes by U+FFFD (for formats
+    /// whose free-text fields, such as an STL solid name, may be in another encoding; a
+    /// replaced byte inside a number still fails to parse).
+    pub(crate) fn lossy(mut self) -> Self {
+        self.lossy = true;
+        self
     }
 
     pub(crate) fn err(&self, reason: impl Into<String>) -> Error {
@@ -73,7 +91,11 @@ impl<R: BufRead> Tokens<R> {
             return Ok(None);
         }
         self.line += 1;
-        let s = std::str::from_utf8(&self.buf).map_err(|_| self.err("line is not valid UTF-8"))?;
+        let s = match std::str::from_utf8(&self.buf) {
+            Ok(s) => std::borrow::Cow::Borrowed(s),
+            Err(_) if self.lossy => String::from_utf8_lossy(&self.buf),
+            Err(_) => return Err(self.err("line is not valid UTF-8")),
+        };
         Ok(Some(s.trim_end_matches(['\n', '\r']).to_string()))
     }
 
@@ -92,6 +114,11 @@ impl<R: BufRead> Tokens<R> {
                 }
             }
         }
+    }
+
+    /// Drops the tokens left on the current line.
+    pub(crate) fn skip_rest_of_line(&mut self) {
+        self.pos = self.tokens.len();
     }
 
     /// Next token or an error naming what was expected.
