@@ -29,9 +29,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use cloner::{
-    Calibrated, CloneModel, Hooks, Params, Parents, RunStats, Scores, TABLES_4_5, score,
-};
+use cloner::{Calibrated, CloneModel, Hooks, Params, Parents, RunStats, Scores, TABLES_4_5, score};
 use morph_dna::{Descriptor, DnaTable, GradingCurve, GradingWeight, SphericalMesh};
 
 use crate::parents::ParentArgs;
@@ -854,10 +852,14 @@ impl Calibrate {
     }
 
     fn check(&self, root: &Path, parents: &Parents) -> anyhow::Result<()> {
-        let path = self.config_path(root).with_context(|| {
-            "--check with --parents needs --out FILE: the calibration to re-score"
-        })?;
-        let shown = path.strip_prefix(root).unwrap_or(&path).display().to_string();
+        let path = self.config_path(root).with_context(
+            || "--check with --parents needs --out FILE: the calibration to re-score",
+        )?;
+        let shown = path
+            .strip_prefix(root)
+            .unwrap_or(&path)
+            .display()
+            .to_string();
         let text = std::fs::read_to_string(&path)
             .with_context(|| format!("reading {}", path.display()))?;
         let cal =

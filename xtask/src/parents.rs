@@ -447,7 +447,11 @@ fn load_image(
     Ok(out)
 }
 
-fn load_meshes(args: &ParentArgs, files: &[PathBuf], format: InputFormat) -> anyhow::Result<Loaded> {
+fn load_meshes(
+    args: &ParentArgs,
+    files: &[PathBuf],
+    format: InputFormat,
+) -> anyhow::Result<Loaded> {
     let t0 = Instant::now();
     let meshes: Vec<(String, levelset::TriMesh, levelset::MeshRepair)> = files
         .par_iter()
@@ -562,15 +566,13 @@ fn load_morph(files: &[PathBuf]) -> anyhow::Result<Loaded> {
 pub(crate) fn measure(loaded: Loaded) -> anyhow::Result<(cloner::Parents, Vec<String>, f64)> {
     let t = Instant::now();
     let names = loaded.names;
-    let parents =
-        cloner::Parents::from_grids(loaded.grids, &morph_dna::MeasureParams::default()).map_err(
-            |e| match &e {
-                cloner::Error::DegenerateParent { index, reason } => anyhow::anyhow!(
-                    "parent {} cannot be measured: {reason}",
-                    names.get(*index).map_or("?", String::as_str)
-                ),
-                _ => anyhow::Error::new(e),
-            },
-        )?;
+    let parents = cloner::Parents::from_grids(loaded.grids, &morph_dna::MeasureParams::default())
+        .map_err(|e| match &e {
+        cloner::Error::DegenerateParent { index, reason } => anyhow::anyhow!(
+            "parent {} cannot be measured: {reason}",
+            names.get(*index).map_or("?", String::as_str)
+        ),
+        _ => anyhow::Error::new(e),
+    })?;
     Ok((parents, names, t.elapsed().as_secs_f64()))
 }

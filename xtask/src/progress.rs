@@ -20,9 +20,9 @@ pub(crate) fn bar(label: &str, total: u64, quiet: bool) -> ProgressBar {
             ProgressDrawTarget::stderr()
         },
     );
-    if let Ok(style) = ProgressStyle::with_template(
-        "  {msg:<40} [{bar:30}] {pos}/{len} {per_sec:>10} ETA {eta}",
-    ) {
+    if let Ok(style) =
+        ProgressStyle::with_template("  {msg:<40} [{bar:30}] {pos}/{len} {per_sec:>10} ETA {eta}")
+    {
         pb.set_style(style.progress_chars("#>-"));
     }
     pb.set_message(label.to_owned());

@@ -864,32 +864,14 @@ pub fn grid_from_mesh(mesh: &levelset::TriMesh, resolution: usize, margin: f64) 
             reason: "in (1, 4]",
         });
     }
-    // volume centroid by signed tetrahedra about the first vertex (translation
-    // invariant, so no cancellation from a far origin)
-    let v = mesh.vertices();
     let degenerate = |reason: String| Error::DegenerateParent { index: 0, reason };
-    let o = v
-        .first()
-        .ok_or_else(|| degenerate("empty mesh".into()))?
-        .coords;
-    let (mut vol, mut c) = (0.0, nalgebra::Vector3::zeros());
-    for t in mesh.triangles() {
-        let (a, b, d) = (v[t[0]].coords - o, v[t[1]].coords - o, v[t[2]].coords - o);
-        let w = a.dot(&b.cross(&d)) / 6.0;
-        vol += w;
-        c += w * (a + b + d) / 4.0;
-    }
-    if !(vol.is_finite() && vol > 0.0) {
+    let volume = mesh.signed_volume();
+    if !(volume.is_finite() && volume > 0.0) {
         return Err(degenerate(format!(
-            "mesh volume {vol} (not closed, inverted or flat)"
+            "mesh volume {volume} (not closed, inverted or flat)"
         )));
     }
-    let centre = nalgebra::Point3::from(o + c / vol);
-    let r_max = v.iter().map(|p| (p - centre).norm()).fold(0.0f64, f64::max);
-    let spec = levelset::GridSpec::cube(resolution, -margin * r_max, margin * r_max)?;
-    let spec = levelset::GridSpec {
-        origin: spec.origin + centre.coords,
-        ..spec
-    };
+    let centre = mesh.centroid()?;
+    let spec = levelset::GridSpec::around_points(mesh.vertices(), centre, resolution, margin)?;
     Ok(Grid::from_mesh(spec, mesh)?)
 }
