@@ -73,6 +73,7 @@ mod crew;
 pub mod error;
 pub mod grid;
 pub mod io;
+pub mod labels;
 pub mod mesh;
 pub mod properties;
 pub mod reinit;
@@ -88,6 +89,10 @@ pub use nalgebra;
 pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};
 pub use grid::{Grid, GridSpec};
+pub use labels::{
+    ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, LabelImage, SkipCounts, SkipReason,
+    Skipped,
+};
 pub use mesh::{MeshDistance, TriMesh};
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};

@@ -1,0 +1,2 @@
+//! Label bench (placeholder).
+fn main() {}
