@@ -418,11 +418,25 @@ fn extract_one(img: &LabelImage, label: u32, st: &Stats, p: &ExtractParams) -> R
             let mut grey: Vec<f64> = mask.iter().map(|&b| f64::from(u8::from(b))).collect();
             drop(mask);
             gaussian_blur(&mut grey, cdims, sigma);
-            match Grid::from_grayscale(spec, &grey, 0.5) {
+            let mut g = match Grid::from_grayscale(spec, &grey, 0.5) {
                 Ok(g) => g,
                 Err(Error::NoSurface) => return skip(voxels, SkipReason::NoSurface),
                 Err(e) => return Err(e),
+            };
+            // The blurred 0.5 level sits ≈ σ²·H inside the voxel surface (H: sum of the
+            // principal curvatures). Offset the signed distance so that the enclosed
+            // volume equals the voxel count (first order: δ = ΔV / A).
+            let mp = match g.mass_properties() {
+                Ok(mp) => mp,
+                Err(Error::NoSurface) => return skip(voxels, SkipReason::NoSurface),
+                Err(e) => return Err(e),
+            };
+            let target = voxels as f64 * img.spacing.powi(3);
+            if mp.area > 0.0 {
+                let delta = (target - mp.volume) / mp.area;
+                g.values_mut().iter_mut().for_each(|v| *v -= delta);
             }
+            g
         }
     };
     Ok(Outcome::Grain(ExtractedGrain {
