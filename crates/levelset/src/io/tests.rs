@@ -196,3 +196,5 @@ proptest! {
         let _ = read_morph(buf.as_slice());
     }
 }
+
+mod labels;

@@ -32,8 +32,10 @@ pub struct ExtractParams {
     pub components: ComponentPolicy,
     /// Voxels of background added around each bounding box (≥ 1). Default 2.
     pub pad: usize,
-    /// Gaussian σ in voxels for the sub-voxel interface (`None`: exact EDT of the binary
-    /// crop). Default `None` (see the module doc for the measurement).
+    /// Gaussian σ in voxels for a sub-voxel, volume-matched interface (`None`: exact EDT of
+    /// the binary crop). Default `Some(1.0)`: the EDT surface keeps a staircase (area
+    /// +12 %, normals off by 11° RMS at any size), σ = 1 brings both under 2 % and 4° for
+    /// grains ≥ 6 voxels across at twice the cost; see the module doc for the measurement.
     pub smoothing: Option<f64>,
     /// Extract grains in parallel with rayon (results are identical either way).
     /// Default `true`.
@@ -47,7 +49,7 @@ impl Default for ExtractParams {
             min_voxels: 100,
             components: ComponentPolicy::KeepLargest,
             pad: 2,
-            smoothing: None,
+            smoothing: Some(1.0),
             parallel: true,
         }
     }

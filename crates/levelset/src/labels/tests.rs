@@ -204,6 +204,7 @@ fn border_components_and_min_voxels() {
     let img = several();
     let p = ExtractParams {
         min_voxels: 5,
+        smoothing: None,
         ..ExtractParams::default()
     };
     let ex = img.extract(&p).expect("extract");
@@ -234,6 +235,7 @@ fn border_components_and_min_voxels() {
         exclude_border: false,
         min_voxels: 1,
         components: ComponentPolicy::Reject,
+        smoothing: None,
         ..ExtractParams::default()
     };
     let ex = img.extract(&p).expect("extract");
@@ -255,13 +257,15 @@ fn border_components_and_min_voxels() {
     let ex = img.extract(&ExtractParams::default()).expect("extract");
     let labels: Vec<u32> = ex.grains.iter().map(|g| g.label).collect();
     assert_eq!(labels, [2, 3]);
-    // Smoothing erases the one-voxel grain: skipped, not an error.
+    // Smoothing (the default) erases the one-voxel grain and the 2³ cube (peak blurred
+    // value ≈ 0.06 and 0.3 < 0.5): skipped, not an error.
     let p = ExtractParams {
         min_voxels: 1,
-        smoothing: Some(1.0),
         ..ExtractParams::default()
     };
     let ex = img.extract(&p).expect("extract");
+    let c = ex.skip_counts();
+    assert_eq!((c.border, c.no_surface), (1, 2), "{:?}", ex.skipped);
     assert!(ex.skipped.contains(&Skipped {
         label: 4,
         voxels: 1,
@@ -285,6 +289,7 @@ fn corner_touching_voxels_are_separate_components() {
     }
     let p = ExtractParams {
         min_voxels: 1,
+        smoothing: None,
         ..ExtractParams::default()
     };
     let ex = img.extract(&p).expect("extract");
@@ -450,18 +455,21 @@ fn smoothing_measurement() {
             row[3].1,
             row[3].2,
         );
-        // Oracles with tolerances derived from the O(h/R) behaviour (R = smallest semi-axis
-        // in voxels): EDT volume within 1.5/R, EDT area within 3/R (corner cutting of the
-        // staircase); smoothed: the blurred 0.5 level moves inward by ≈ σ²·H (H = mean
-        // curvature sum ≈ 2/R), so volume within 3σ²·(2/R)/R·… bounded by 6/R², area 4/R.
+        // Oracles (r = smallest semi-axis in voxels). EDT: volume O(h/R) (the trilinear
+        // surface cuts the staircase's corners), measured ≤ 0.33/r, asserted 0.4/r; area
+        // biased by +9 to +13 % at every size and normals by 11° RMS (today's behaviour:
+        // the staircase does not converge). σ = 1 with the volume match: volume and area
+        // O(h/R), measured ≤ 0.07/r, asserted 0.1/r; normals ≤ 3.6°, asserted 4.5°.
         let r = semi_vox.min();
-        assert!(row[0].0.abs() < 1.5 / r, "EDT volume {:?}", row[0]);
-        assert!(row[0].1.abs() < 3.0 / r, "EDT area {:?}", row[0]);
+        assert!(row[0].0.abs() < 0.4 / r, "EDT volume {:?}", row[0]);
+        assert!(row[0].1 > 0.05 && row[0].1 < 0.15, "EDT area {:?}", row[0]);
         assert!(
-            row[1].0.abs() < 9.0 / (r * r) + 0.5 / r,
-            "σ volume {:?}",
-            row[1]
+            row[0].2 > 8.0 && row[0].2 < 13.0,
+            "EDT normals {:?}",
+            row[0]
         );
-        assert!(row[1].1.abs() < 4.0 / r, "σ area {:?}", row[1]);
+        assert!(row[1].0.abs() < 0.1 / r, "σ volume {:?}", row[1]);
+        assert!(row[1].1.abs() < 0.1 / r, "σ area {:?}", row[1]);
+        assert!(row[1].2 < 4.5, "σ normals {:?}", row[1]);
     }
 }
