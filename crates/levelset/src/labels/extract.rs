@@ -307,27 +307,41 @@ pub(crate) fn gaussian_blur(values: &mut [f64], dims: [usize; 3], sigma: f64) {
         .collect();
     let total: f64 = w.iter().sum();
     w.iter_mut().for_each(|x| *x /= total);
-    let stride = [1, dims[0], dims[0] * dims[1]];
+    let [nx, ny, nz] = dims;
+    let stride = [1, nx, nx * ny];
     let mut line = Vec::new();
+    let mut out = Vec::new();
     for axis in 0..3 {
         let len = dims[axis];
         let s = stride[axis];
         line.resize(len, 0.0);
-        for start in 0..values.len() {
-            if (start / s) % len != 0 {
-                continue;
-            }
+        out.resize(len, 0.0);
+        // First node of every line along `axis`.
+        let starts: Box<dyn Iterator<Item = usize>> = match axis {
+            0 => Box::new((0..ny * nz).map(move |r| r * nx)),
+            1 => Box::new((0..nz).flat_map(move |k| (0..nx).map(move |i| i + nx * ny * k))),
+            _ => Box::new(0..nx * ny),
+        };
+        for start in starts {
+            let mut any = false;
             for (t, x) in line.iter_mut().enumerate() {
                 *x = values[start + t * s];
+                any |= *x != 0.0;
             }
-            for t in 0..len {
+            if !any {
+                continue;
+            }
+            for (t, o) in out.iter_mut().enumerate() {
                 let a = t.saturating_sub(r);
                 let b = (t + r).min(len - 1);
-                let mut acc = 0.0;
-                for (q, &x) in line[a..=b].iter().enumerate() {
-                    acc += w[a + q + r - t] * x;
-                }
-                values[start + t * s] = acc;
+                *o = line[a..=b]
+                    .iter()
+                    .zip(&w[a + r - t..])
+                    .map(|(x, wt)| x * wt)
+                    .sum();
+            }
+            for (t, &o) in out.iter().enumerate() {
+                values[start + t * s] = o;
             }
         }
     }
@@ -355,10 +369,7 @@ fn extract_one(img: &LabelImage, label: u32, st: &Stats, p: &ExtractParams) -> R
         return skip(st.count, SkipReason::TooSmall);
     }
     let pad = p.pad;
-    let mut cdims = [0usize; 3];
-    for a in 0..3 {
-        cdims[a] = st.hi[a] - st.lo[a] + 1 + 2 * pad;
-    }
+    let cdims: [usize; 3] = std::array::from_fn(|a| st.hi[a] - st.lo[a] + 1 + 2 * pad);
     let n = cdims[0]
         .checked_mul(cdims[1])
         .and_then(|v| v.checked_mul(cdims[2]))

@@ -25,7 +25,7 @@ fn coded(extra: u32) -> LabelImage {
 fn npy(version: u8, dict: &str, data: &[u8]) -> Vec<u8> {
     let mut h = dict.to_string();
     let pre = if version == 1 { 10 } else { 12 };
-    while (pre + h.len() + 1) % 64 != 0 {
+    while !(pre + h.len() + 1).is_multiple_of(64) {
         h.push(' ');
     }
     h.push('\n');
