@@ -21,7 +21,14 @@
 //!   [`Grid::mass_properties_of`] integrates without walking the grid again (bit for bit
 //!   [`Grid::mass_properties`]).
 //! * LS-DEM contact: [`Body`], [`contact()`] / [`contact_into`] → [`NodeContact`].
-//! * [`io`]: LS-DEM morph files, LAMMPS LSDEM grid files, VTK structured points, STL.
+//! * Labelled images (watershed-segmented CT scans): [`LabelImage`] (x fastest, 0 =
+//!   background, [`LabelImage::paint`] rasterises grids), [`LabelImage::extract`] →
+//!   [`Extraction`] (one level set per grain, [`ExtractParams`]: border exclusion,
+//!   `min_voxels`, [`ComponentPolicy`], pad, Gaussian smoothing; [`Skipped`] labels with a
+//!   [`SkipReason`]), see [`labels`].
+//! * [`io`]: LS-DEM morph files, LAMMPS LSDEM grid files, VTK structured points, STL; label
+//!   images as NumPy `.npy`, multi-page TIFF and raw binary ([`io::Dtype`],
+//!   [`io::RawLayout`]).
 //!
 //! # Example
 //! ```
