@@ -473,3 +473,62 @@ fn smoothing_measurement() {
         assert!(row[1].2 < 4.5, "σ normals {:?}", row[1]);
     }
 }
+
+mod props {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(128))]
+
+        /// Any small image and any valid parameters: no panic; every label is either a
+        /// grain or skipped, in ascending order; serial and parallel agree.
+        #[test]
+        fn extract_never_panics(
+            dims in proptest::array::uniform3(1usize..9),
+            seed in any::<u64>(),
+            pad in 1usize..4,
+            min_voxels in 1usize..6,
+            smoothing in proptest::option::of(0.3f64..2.0),
+            reject in any::<bool>(),
+            exclude_border in any::<bool>(),
+        ) {
+            let n = dims[0] * dims[1] * dims[2];
+            let mut state = seed | 1;
+            let labels: Vec<u32> = (0..n)
+                .map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    let r = (state % 10) as u32;
+                    if r < 5 { 0 } else { r - 4 }
+                })
+                .collect();
+            let img = LabelImage::new(dims, 0.3, labels).expect("image");
+            let p = ExtractParams {
+                exclude_border,
+                min_voxels,
+                components: if reject { ComponentPolicy::Reject } else { ComponentPolicy::KeepLargest },
+                pad,
+                smoothing,
+                parallel: true,
+            };
+            let a = img.extract(&p);
+            let b = img.extract(&ExtractParams { parallel: false, ..p });
+            match (&a, &b) {
+                (Ok(a), Ok(b)) => {
+                    prop_assert_eq!(a, b);
+                    prop_assert_eq!(a.grains.len() + a.skipped.len(), a.labels_found);
+                    prop_assert!(a.grains.windows(2).all(|w| w[0].label < w[1].label));
+                    prop_assert!(a.skipped.windows(2).all(|w| w[0].label < w[1].label));
+                    for g in &a.grains {
+                        prop_assert!(g.grid.dims().iter().all(|&d| d >= 3));
+                        prop_assert!(g.voxels >= min_voxels);
+                    }
+                }
+                (Err(e), Err(f)) => prop_assert_eq!(e.to_string(), f.to_string()),
+                _ => prop_assert!(false, "parallel and serial disagree"),
+            }
+        }
+    }
+}
