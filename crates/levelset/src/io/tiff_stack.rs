@@ -88,8 +88,11 @@ pub fn read_tiff(r: impl Read + Seek, spacing: f64) -> Result<LabelImage> {
                 format!("page is {w} × {h} pixels but page 0 is {nx} × {ny}"),
             ));
         }
+        if w == 0 || h == 0 {
+            return Err(terr(page, format!("page has {w} × {h} pixels")));
+        }
         let voxels = (w as u64) * (h as u64) * (page as u64 + 1);
-        if w == 0 || h == 0 || voxels > MAX_VOXELS {
+        if voxels > MAX_VOXELS {
             return Err(Error::ImageTooLarge {
                 dims: [w, h, page + 1],
                 max_voxels: MAX_VOXELS,
