@@ -35,7 +35,8 @@ pub struct ExtractParams {
     /// Gaussian σ in voxels for a sub-voxel, volume-matched interface (`None`: exact EDT of
     /// the binary crop). Default `Some(1.0)`: the EDT surface keeps a staircase (area
     /// +12 %, normals off by 11° RMS at any size), σ = 1 brings both under 2 % and 4° for
-    /// grains ≥ 6 voxels across at twice the cost; see the module doc for the measurement.
+    /// grains ≥ 6 voxels across at 2.5 times the cost; see the module doc for the
+    /// measurement.
     pub smoothing: Option<f64>,
     /// Extract grains in parallel with rayon (results are identical either way).
     /// Default `true`.
