@@ -413,6 +413,10 @@ fn load_image(
                 levelset::SkipReason::SeveralComponents { .. } => {
                     "split into several components (--reject-split)".to_owned()
                 }
+                levelset::SkipReason::NoSurface => {
+                    "thinner than the smoothing blur (no surface)".to_owned()
+                }
+                _ => format!("skipped ({:?})", s.reason),
             };
             (format!("label {}", s.label), why)
         })

@@ -219,6 +219,90 @@ pub enum Error {
         /// What was wrong.
         reason: String,
     },
+    /// A label image axis has no voxel.
+    #[error("label image axis {axis} has size 0; every axis needs at least one voxel")]
+    EmptyAxis {
+        /// Axis index (0 = x, 1 = y, 2 = z).
+        axis: usize,
+    },
+    /// A label image (or a file header) claims more voxels than the crate accepts.
+    #[error("label image of {dims:?} voxels is too large (at most {max_voxels} voxels)")]
+    ImageTooLarge {
+        /// Claimed dimensions (x, y, z); for a header, the shape as declared.
+        dims: [usize; 3],
+        /// The cap ([`crate::labels::MAX_VOXELS`]).
+        max_voxels: u64,
+    },
+    /// A stored label is negative or does not fit a `u32`.
+    #[error("{format} label {value} at byte offset {offset} is out of range (0 ..= 4294967295)")]
+    LabelOutOfRange {
+        /// Format name (`"npy"`, `"raw"`).
+        format: &'static str,
+        /// Byte offset of the element from the start of the stream.
+        offset: u64,
+        /// The stored value.
+        value: i64,
+    },
+    /// A label does not fit the data type asked for by a writer.
+    #[error("label {label} at voxel {index} does not fit the data type {dtype}")]
+    LabelDoesNotFit {
+        /// The label.
+        label: u32,
+        /// Linear voxel index (x fastest).
+        index: usize,
+        /// The requested data type.
+        dtype: crate::io::Dtype,
+    },
+    /// A data type name or NumPy `descr` that is not supported.
+    #[error(
+        "unsupported data type {name:?}; supported: u8, u16, u32, i32, i64 (npy: |u1 <u2 >u2 <u4 >u4 <i4 >i4 <i8 >i8)"
+    )]
+    UnsupportedDtype {
+        /// The name or `descr` found.
+        name: String,
+    },
+    /// The data section of a binary stream is shorter or longer than the header or layout says.
+    #[error("{format} data size mismatch: expected {expected} bytes of voxel data, found {found}")]
+    DataSizeMismatch {
+        /// Format name (`"npy"`, `"raw"`).
+        format: &'static str,
+        /// Bytes required by the shape and data type.
+        expected: u64,
+        /// Bytes present (counted to the end of the stream).
+        found: u64,
+    },
+    /// A TIFF page cannot be read as a label slice.
+    #[error("tiff page {page}: {reason}")]
+    Tiff {
+        /// 0-based page (= z slice) index.
+        page: usize,
+        /// What was wrong, naming the layout found (colour type, bits, sample format, size).
+        reason: String,
+    },
+    /// A label image holds no grain (every voxel is 0).
+    #[error("the label image has no non-zero label (all {voxels} voxels are background)")]
+    EmptyLabelImage {
+        /// Number of voxels.
+        voxels: usize,
+    },
+    /// Extraction found labels but kept none of them.
+    #[error(
+        "no usable grain among {labels} labels: {border} touch the image border, {too_small} have fewer than {min_voxels} voxels, {several_components} have several components, {no_surface} lost their surface to smoothing"
+    )]
+    NoUsableGrain {
+        /// Distinct non-zero labels found.
+        labels: usize,
+        /// Skipped because they touch the border.
+        border: usize,
+        /// Skipped because they are too small.
+        too_small: usize,
+        /// The `min_voxels` threshold in force.
+        min_voxels: usize,
+        /// Rejected for having several connected components.
+        several_components: usize,
+        /// Skipped because the smoothed image did not cross the threshold.
+        no_surface: usize,
+    },
     /// Reading or writing failed.
     #[error("i/o error: {0}")]
     Io(#[from] std::io::Error),

@@ -24,8 +24,14 @@
 //!   [`Grid::mass_properties_of`] integrates without walking the grid again (bit for bit
 //!   [`Grid::mass_properties`]).
 //! * LS-DEM contact: [`Body`], [`contact()`] / [`contact_into`] → [`NodeContact`].
+//! * Labelled images (watershed-segmented CT scans): [`LabelImage`] (x fastest, 0 =
+//!   background, [`LabelImage::paint`] rasterises grids), [`LabelImage::extract`] →
+//!   [`Extraction`] (one level set per grain, [`ExtractParams`]: border exclusion,
+//!   `min_voxels`, [`ComponentPolicy`], pad, Gaussian smoothing; [`Skipped`] labels with a
+//!   [`SkipReason`]), see [`labels`].
 //! * [`io`]: LS-DEM morph files, LAMMPS LSDEM grid files, VTK structured points, STL
-//!   (binary and ASCII) and Wavefront OBJ meshes.
+//!   (binary and ASCII) and Wavefront OBJ meshes; label images as NumPy `.npy`, multi-page TIFF and raw binary ([`io::Dtype`],
+//!   [`io::RawLayout`]).
 //!
 //! # Example
 //! ```
@@ -80,6 +86,7 @@ mod crew;
 pub mod error;
 pub mod grid;
 pub mod io;
+pub mod labels;
 pub mod mesh;
 pub mod properties;
 pub mod reinit;
@@ -95,6 +102,10 @@ pub use nalgebra;
 pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};
 pub use grid::{Grid, GridSpec};
+pub use labels::{
+    ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, LabelImage, SkipCounts, SkipReason,
+    Skipped,
+};
 pub use mesh::{MeshDistance, MeshRepair, Orientation, TriMesh};
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};

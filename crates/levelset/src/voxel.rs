@@ -62,9 +62,29 @@ fn dt1d(f: &[f64], d: &mut [f64], v: &mut [usize], z: &mut [f64]) {
 fn edt(dims: [usize; 3], seed: impl Fn(usize) -> bool) -> Vec<f64> {
     let [nx, ny, nz] = dims;
     let n = nx * ny * nz;
-    let mut g: Vec<f64> = (0..n)
-        .map(|i| if seed(i) { 0.0 } else { f64::INFINITY })
-        .collect();
+    // First axis directly: the squared distance to the nearest seed of the row, by a
+    // forward and a backward scan (the same values as the parabola transform of 0/∞).
+    let mut g = vec![f64::INFINITY; n];
+    for (r, row) in g.chunks_exact_mut(nx).enumerate() {
+        let base = r * nx;
+        let mut last: Option<usize> = None;
+        for (i, x) in row.iter_mut().enumerate() {
+            if seed(base + i) {
+                last = Some(i);
+            }
+            if let Some(q) = last {
+                *x = ((i - q) * (i - q)) as f64;
+            }
+        }
+        let mut next: Option<usize> = None;
+        for (i, x) in row.iter_mut().enumerate().rev() {
+            if *x == 0.0 {
+                next = Some(i);
+            } else if let Some(q) = next {
+                *x = x.min(((q - i) * (q - i)) as f64);
+            }
+        }
+    }
     let m = nx.max(ny).max(nz);
     let (mut f, mut d, mut v, mut z) = (
         vec![0.0; m],
@@ -73,14 +93,17 @@ fn edt(dims: [usize; 3], seed: impl Fn(usize) -> bool) -> Vec<f64> {
         vec![0.0; m + 1],
     );
     let stride = [1, nx, nx * ny];
-    for axis in 0..3 {
+    for axis in 1..3 {
         let len = dims[axis];
         let s = stride[axis];
-        for start in 0..n {
-            // Visit each line once: start must have coordinate 0 along `axis`.
-            if (start / s) % len != 0 {
-                continue;
-            }
+        // Visit each line once from its node with coordinate 0 along `axis` (enumerated
+        // directly: an integer division per node costs as much as the transform).
+        let starts: Box<dyn Iterator<Item = usize>> = if axis == 1 {
+            Box::new((0..nz).flat_map(move |k| (0..nx).map(move |i| i + nx * ny * k)))
+        } else {
+            Box::new(0..nx * ny)
+        };
+        for start in starts {
             for t in 0..len {
                 f[t] = g[start + t * s];
             }

@@ -1,6 +1,13 @@
 //! Readers and writers over `BufRead` / `Write`: LS-DEM morph files, LAMMPS LSDEM grid
-//! files, VTK legacy structured points (ParaView), and surface meshes as STL (binary and
-//! ASCII) and Wavefront OBJ.
+//! files, VTK legacy structured points (ParaView), surface meshes as STL (binary and ASCII) and
+//! Wavefront OBJ; labelled 3D
+//! images ([`crate::LabelImage`]) as NumPy `.npy` ([`read_npy`]), multi-page TIFF stacks
+//! ([`read_tiff`], over `Read + Seek`) and raw binary ([`read_raw`]).
+//!
+//! Label readers stream: elements are converted to `u32` in 1 MiB chunks (TIFF: page by
+//! page), declared sizes are checked against [`crate::labels::MAX_VOXELS`] before anything
+//! is allocated, and at most 2²⁴ labels are reserved from a header before the data arrive.
+//! They never panic on any byte string (proptests in `io/tests.rs`).
 //!
 //! Writers print floats with Rust's shortest round-trip representation (switching to
 //! exponent notation outside 1e-4 ≤ |x| < 1e15), so every text writer round-trips exactly.
@@ -15,14 +22,20 @@
 
 mod lammps;
 mod morph;
+mod npy;
 mod obj;
+mod raw;
 mod stl;
+mod tiff_stack;
 mod vtk;
 
 pub use lammps::{read_lammps, write_lammps};
 pub use morph::{MorphFile, read_morph, write_morph};
+pub use npy::{read_npy, write_npy};
 pub use obj::{read_obj, write_obj};
+pub use raw::{Dtype, RawLayout, read_raw, write_raw};
 pub use stl::{read_stl, write_stl_ascii, write_stl_binary};
+pub use tiff_stack::{read_tiff, write_tiff};
 pub use vtk::{read_vtk, write_vtk};
 
 use std::fmt::Write as _;

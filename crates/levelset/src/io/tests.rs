@@ -493,3 +493,5 @@ proptest! {
         let _ = read_morph(buf.as_slice());
     }
 }
+
+mod labels;
