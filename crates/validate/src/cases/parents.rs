@@ -32,12 +32,32 @@ pub const POPULATION_T_OVER_W: f64 = 0.744;
 pub const POPULATION_W_OVER_L: f64 = 0.804;
 
 pub(crate) fn cases() -> Vec<Case> {
-    vec![Case {
-        name: "parents/ottawa-representative",
-        description: "median flatness and elongation of the default parents (71 random Ottawa grains, caliper extents along the principal axes) within 0.03 of NIST's population medians T/W 0.744 and W/L 0.804",
-        fast: false,
-        run: ottawa_representative,
-    }]
+    vec![
+        Case {
+            name: "parents/ottawa-representative",
+            description: "median flatness and elongation of the default parents (71 random Ottawa grains, caliper extents along the principal axes) within 0.03 of NIST's population medians T/W 0.744 and W/L 0.804",
+            fast: false,
+            run: ottawa_representative,
+        },
+        Case {
+            name: "parents/roundtrip-npy",
+            description: "40 calibrated Ottawa clones painted into a labelled u16 .npy image (30 voxels across the median grain), written, read back and extracted as parents: image identical, every grain back, each DNA parameter within tolerances derived from h/D",
+            fast: false,
+            run: roundtrip_npy,
+        },
+        Case {
+            name: "parents/roundtrip-tiff",
+            description: "the same clones through a multi-page TIFF stack: image identical, every grain back, DNA within the h/D tolerances",
+            fast: false,
+            run: roundtrip_tiff,
+        },
+        Case {
+            name: "parents/roundtrip-stl",
+            description: "the same clones as binary STL surfaces (marching cubes of their level sets), read back, checked closed and outward (Refuse policy), re-rasterised at 45³: DNA within the h/D tolerances",
+            fast: false,
+            run: roundtrip_stl,
+        },
+    ]
 }
 
 pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[ExpectedFailure {
@@ -176,4 +196,255 @@ fn ottawa_representative() -> Result<Vec<Check>, Error> {
         ),
         Check::new("grains", 71.0, m.grains as f64, Tolerance::Within(0.0)),
     ])
+}
+
+/// Grids painted one per cell of a cubic lattice into a labelled image
+/// (labels `1..=n` in the grids' order), each cell the largest grid box plus
+/// `gap` background voxels on every side, so no grain touches another or
+/// the border. Used by the round-trip cases and `cargo xtask synth-scan`.
+///
+/// # Errors
+/// [`Error::Computation`] for a non-positive voxel size, no grids, or a
+/// painting error.
+pub fn paint_lattice(
+    grids: &[levelset::Grid],
+    voxel: f64,
+    gap: usize,
+) -> Result<levelset::LabelImage, Error> {
+    if !(voxel.is_finite() && voxel > 0.0) || grids.is_empty() {
+        return Err(err(format!(
+            "paint_lattice: voxel {voxel}, {} grids",
+            grids.len()
+        )));
+    }
+    let extent = grids
+        .iter()
+        .map(|g| {
+            let s = g.spec();
+            s.dims.iter().copied().max().unwrap_or(0) as f64 * s.spacing
+        })
+        .fold(0.0f64, f64::max);
+    let cell = (extent / voxel).ceil() as usize + 2 * gap;
+    let m = (1..).find(|m| m * m * m >= grids.len()).unwrap_or(1);
+    let mut image =
+        levelset::LabelImage::zeros([m * cell, m * cell, m * cell], voxel).map_err(err)?;
+    for (n, g) in grids.iter().enumerate() {
+        let (i, j, k) = (n % m, (n / m) % m, n / (m * m));
+        let corner = levelset::nalgebra::Vector3::new(
+            ((i * cell + gap) as f64) * voxel,
+            ((j * cell + gap) as f64) * voxel,
+            ((k * cell + gap) as f64) * voxel,
+        );
+        let offset = corner - g.spec().origin.coords;
+        let label = u32::try_from(n + 1).map_err(err)?;
+        image.paint(label, g, offset).map_err(err)?;
+    }
+    Ok(image)
+}
+
+/// Clones of the round trips: the first [`ROUNDTRIP_CLONES`] clones of the
+/// calibrated Ottawa configuration, with their level sets and their own DNA
+/// (the cloner's [`cloner::DNA`] order). Computed once per process.
+pub const ROUNDTRIP_CLONES: u64 = 40;
+
+/// Voxels across the median clone's equivalent diameter in the labelled
+/// round trips (a typical CT resolution for sand: 20–40 voxels per grain).
+pub const ROUNDTRIP_VOXELS_PER_DIAMETER: f64 = 30.0;
+
+fn roundtrip_clones() -> Result<&'static (Vec<levelset::Grid>, Vec<Vec<f64>>), Error> {
+    static CLONES: std::sync::OnceLock<Result<(Vec<levelset::Grid>, Vec<Vec<f64>>), String>> =
+        std::sync::OnceLock::new();
+    CLONES
+        .get_or_init(|| {
+            let run = || -> Result<(Vec<levelset::Grid>, Vec<Vec<f64>>), Error> {
+                let text = crate::fixtures::calibrated_files()
+                    .iter()
+                    .find(|(n, _)| *n == "gsc2-ottawa.ron")
+                    .map(|(_, t)| *t)
+                    .ok_or_else(|| Error::MissingFixture {
+                        name: "calibrated/gsc2-ottawa.ron".into(),
+                    })?;
+                let cal = cloner::Calibrated::from_ron(text).map_err(err)?;
+                let mut params = cal.params;
+                params.outputs = cloner::Outputs {
+                    level_set: true,
+                    dna: true,
+                };
+                let parents = grains::ottawa_parents()?;
+                let model = cloner::CloneModel::fit(&parents, &params).map_err(err)?;
+                let run = model
+                    .run(0..ROUNDTRIP_CLONES, cloner::Hooks::default())
+                    .map_err(err)?;
+                let mut grids = Vec::new();
+                let mut dna = Vec::new();
+                for c in run.clones {
+                    if let (Some(g), Some(d)) = (c.grid, c.dna) {
+                        grids.push(g);
+                        dna.push(d);
+                    }
+                }
+                Ok((grids, dna))
+            };
+            run().map_err(|e| e.to_string())
+        })
+        .as_ref()
+        .map_err(|m| Error::Computation { message: m.clone() })
+}
+
+/// Per-descriptor relative differences |re-read − clone| / clone.
+fn relative_differences(own: &[Vec<f64>], reread: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    (0..cloner::DNA.len())
+        .map(|k| {
+            own.iter()
+                .zip(reread)
+                .map(|(a, b)| ((b[k] - a[k]) / a[k]).abs())
+                .collect()
+        })
+        .collect()
+}
+
+fn measure_dna(grids: &[&levelset::Grid]) -> Result<Vec<Vec<f64>>, Error> {
+    grids
+        .iter()
+        .map(|g| morph_dna::measure(g, &cloner::DNA, &MeasureParams::default()).map_err(err))
+        .collect()
+}
+
+/// Round trip through a labelled image written and read by `write`/`read`.
+fn roundtrip_image(
+    write: impl Fn(&levelset::LabelImage) -> Result<Vec<u8>, levelset::Error>,
+    read: impl Fn(&[u8], f64) -> Result<levelset::LabelImage, levelset::Error>,
+) -> Result<Vec<Check>, Error> {
+    let (grids, own) = roundtrip_clones()?;
+    let d: Vec<f64> = own.iter().map(|r| r[1]).collect();
+    let h = median(&d) / ROUNDTRIP_VOXELS_PER_DIAMETER;
+    let image = paint_lattice(grids, h, 3)?;
+    let bytes = write(&image).map_err(err)?;
+    let back = read(&bytes, h).map_err(err)?;
+    let same = back.dims == image.dims && back.labels == image.labels;
+    let ex = back
+        .extract(&levelset::ExtractParams::default())
+        .map_err(err)?;
+    let mut checks = vec![
+        Check::new(
+            "image read back voxel for voxel (1 = identical)",
+            1.0,
+            f64::from(u8::from(same)),
+            Tolerance::Within(0.0),
+        ),
+        Check::new(
+            "grains extracted",
+            grids.len() as f64,
+            ex.grains.len() as f64,
+            Tolerance::Within(0.0),
+        ),
+    ];
+    let by_label: Vec<&levelset::Grid> = ex.grains.iter().map(|g| &g.grid).collect();
+    let labels: Vec<usize> = ex.grains.iter().map(|g| g.label as usize - 1).collect();
+    let reread = measure_dna(&by_label)?;
+    let own: Vec<Vec<f64>> = labels.iter().map(|&i| own[i].clone()).collect();
+    dna_checks(&mut checks, &own, &reread, h / median(&d), "voxel");
+    Ok(checks)
+}
+
+/// The tolerances of the round trips, derived from the resolution `h / D`
+/// (`h` the voxel or grid spacing, `D` the median equivalent diameter; both
+/// round trips here have h/D = 1/30):
+///
+/// * **equivalent diameter** — the re-read surface is fitted to the voxel
+///   count (labelled) or integrated over the marching-cubes mesh (STL), so
+///   the volume error is a boundary-layer term: a surface misplaced by at
+///   most δ = h/4 on average changes V by A·δ, i.e. ΔV/V = 6·δ/D for a
+///   sphere and ΔD/D = ΔV/3V = 2·δ/D = h/(2D); mean tolerance h/(2D), worst
+///   2× that;
+/// * **aspect ratio, min principal dimension, flatness** — second moments of
+///   the same volume: the boundary term ΔI/I ≈ 10·δ/D shifts a principal
+///   length by 5·δ/D = 5h/(4D) at most; mean tolerance 5h/(4D), worst 2×;
+/// * **V/S** — the area of a re-sampled surface differs by its sub-grid
+///   roughness (the smoothing of voxel staircases or of the marching-cubes
+///   facets), ≈ 2·h/D on curved grains: mean tolerance 2h/D, worst 2×;
+/// * **roundness** — a curvature ratio (corner curvature radius over the
+///   inscribed radius): curvature is a second derivative of the surface, so
+///   its resampling error is O(1) per corner where the corner radius is a
+///   few h, and only the average over corners is stable; mean tolerance
+///   4h/D·(D / r_corner ≈ 5) = 20h/D, worst 2×.
+fn dna_checks(checks: &mut Vec<Check>, own: &[Vec<f64>], reread: &[Vec<f64>], hd: f64, what: &str) {
+    let rel = relative_differences(own, reread);
+    let factors = [1.25, 0.5, 20.0, 2.0, 1.25, 1.25];
+    for (k, d) in cloner::DNA.iter().enumerate() {
+        let mean = rel[k].iter().sum::<f64>() / rel[k].len().max(1) as f64;
+        let worst = rel[k].iter().fold(0.0f64, |a, b| a.max(*b));
+        let tol = factors[k] * hd;
+        checks.push(Check::new(
+            format!(
+                "{} mean |rel. diff| <= {:.2} {what}/D",
+                d.name(),
+                factors[k]
+            ),
+            tol,
+            mean,
+            Tolerance::AtMost(0.0),
+        ));
+        checks.push(Check::new(
+            format!(
+                "{} worst |rel. diff| <= {:.2} {what}/D",
+                d.name(),
+                2.0 * factors[k]
+            ),
+            2.0 * tol,
+            worst,
+            Tolerance::AtMost(0.0),
+        ));
+    }
+}
+
+fn roundtrip_npy() -> Result<Vec<Check>, Error> {
+    roundtrip_image(
+        |img| {
+            let mut buf = Vec::new();
+            levelset::io::write_npy(&mut buf, img, levelset::io::Dtype::U16)?;
+            Ok(buf)
+        },
+        |b, h| levelset::io::read_npy(b, h),
+    )
+}
+
+fn roundtrip_tiff() -> Result<Vec<Check>, Error> {
+    roundtrip_image(
+        |img| {
+            let mut buf = std::io::Cursor::new(Vec::new());
+            levelset::io::write_tiff(&mut buf, img)?;
+            Ok(buf.into_inner())
+        },
+        |b, h| levelset::io::read_tiff(std::io::Cursor::new(b), h),
+    )
+}
+
+fn roundtrip_stl() -> Result<Vec<Check>, Error> {
+    let (grids, own) = roundtrip_clones()?;
+    let d: Vec<f64> = own.iter().map(|r| r[1]).collect();
+    let mut reread_grids = Vec::new();
+    let mut hd = 0.0f64;
+    for g in grids {
+        let mut buf = Vec::new();
+        levelset::io::write_stl_binary(&mut buf, &g.marching_cubes()).map_err(err)?;
+        let mesh = levelset::io::read_stl(buf.as_slice()).map_err(err)?;
+        let (mesh, _) = mesh
+            .prepare_closed(levelset::Orientation::Refuse)
+            .map_err(err)?;
+        let r = cloner::grid_from_mesh(&mesh, 45, 1.1).map_err(err)?;
+        hd = hd.max(r.spec().spacing.max(g.spec().spacing));
+        reread_grids.push(r);
+    }
+    let hd = hd / median(&d);
+    let refs: Vec<&levelset::Grid> = reread_grids.iter().collect();
+    let reread = measure_dna(&refs)?;
+    let mut checks = vec![Check::new(
+        "grains read back",
+        grids.len() as f64,
+        reread.len() as f64,
+        Tolerance::Within(0.0),
+    )];
+    dna_checks(&mut checks, own, &reread, hd, "h");
+    Ok(checks)
 }
