@@ -26,6 +26,7 @@ mod pack_cmd;
 mod parents;
 mod progress;
 mod svg;
+mod synth_scan;
 mod validate_cmd;
 
 #[cfg(test)]
@@ -56,6 +57,9 @@ enum Command {
     /// Pack a 2D domain with disks (Pinto 2009's advancing front) and write
     /// CSV, VTU (ParaView), LIGGGHTS/LAMMPS data, Yade text and SVG.
     Pack(pack_cmd::Pack),
+    /// Write a synthetic labelled CT image of cloned grains (scale tests of
+    /// `--parents`).
+    SynthScan(synth_scan::SynthScan),
     /// Write the spherical-harmonic convergence table of the reference
     /// shapes (degree 1..30).
     Convergence(convergence::Convergence),
@@ -83,6 +87,7 @@ fn main() -> anyhow::Result<()> {
         Command::Dna(cmd) => cmd.run(&workspace_root()),
         Command::Convergence(cmd) => cmd.run(&workspace_root()),
         Command::Pack(cmd) => cmd.run(&workspace_root()),
+        Command::SynthScan(cmd) => cmd.run(&workspace_root()),
     }
 }
 
