@@ -580,3 +580,224 @@ pub(crate) fn measure(loaded: Loaded) -> anyhow::Result<(cloner::Parents, Vec<St
     })?;
     Ok((parents, names, t.elapsed().as_secs_f64()))
 }
+
+#[cfg(test)]
+mod tests {
+    //! Bad input through the file path: every error names the file (and
+    //! what the parser located), nothing is half-written.
+
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        let d =
+            std::env::temp_dir().join(format!("grainforge-parents-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).expect("temp dir");
+        d
+    }
+
+    fn args() -> ParentArgs {
+        ParentArgs {
+            parents: None,
+            format: None,
+            spacing: None,
+            raw_dims: None,
+            raw_dtype: None,
+            big_endian: false,
+            keep_border: false,
+            min_voxels: None,
+            reject_split: false,
+            smoothing: None,
+            sh_degree: None,
+            resolution: 21,
+        }
+    }
+
+    fn err_of(a: &ParentArgs, p: &Path) -> String {
+        match load(a, p) {
+            Ok(l) => panic!("expected an error, read {} grains", l.grids.len()),
+            Err(e) => format!("{e:#}"),
+        }
+    }
+
+    fn cube(open: bool) -> levelset::TriMesh {
+        let v: Vec<nalgebra::Point3<f64>> = (0..8)
+            .map(|c| {
+                nalgebra::Point3::new(
+                    f64::from(c & 1),
+                    f64::from((c >> 1) & 1),
+                    f64::from((c >> 2) & 1),
+                )
+            })
+            .collect();
+        let mut t = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        if open {
+            t.truncate(10);
+        }
+        levelset::TriMesh::new(v, t).expect("cube")
+    }
+
+    fn write_stl(p: &Path, m: &levelset::TriMesh) {
+        let mut buf = Vec::new();
+        levelset::io::write_stl_binary(&mut buf, m).expect("stl");
+        std::fs::write(p, buf).expect("write");
+    }
+
+    fn write_npy(p: &Path, img: &levelset::LabelImage) {
+        let mut buf = Vec::new();
+        levelset::io::write_npy(&mut buf, img, levelset::io::Dtype::U16).expect("npy");
+        std::fs::write(p, buf).expect("write");
+    }
+
+    /// Two separated cubes of `side` voxels, labels 1 and 2.
+    fn two_grains(side: usize, at_border: bool) -> levelset::LabelImage {
+        let n = 2 * side + 8;
+        let mut img = levelset::LabelImage::zeros([n, side + 6, side + 6], 1.0).expect("image");
+        let o = usize::from(!at_border) * 3;
+        for (label, x0) in [(1u32, o), (2, side + 6)] {
+            for k in o..o + side {
+                for j in o..o + side {
+                    for i in x0..x0 + side {
+                        let idx = img.index(i, j, k);
+                        img.labels[idx] = label;
+                    }
+                }
+            }
+        }
+        img
+    }
+
+    #[test]
+    fn a_directory_mixing_formats_names_two_files() {
+        let d = tmp("mixed");
+        write_stl(&d.join("a.stl"), &cube(false));
+        let mut obj = Vec::new();
+        levelset::io::write_obj(&mut obj, &cube(false)).expect("obj");
+        std::fs::write(d.join("b.obj"), obj).expect("write");
+        let e = err_of(&args(), &d);
+        assert!(
+            e.contains("mixes formats") && e.contains("a.stl") && e.contains("b.obj"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn an_open_stl_is_an_error_naming_the_file() {
+        let d = tmp("open");
+        write_stl(&d.join("good.stl"), &cube(false));
+        write_stl(&d.join("holey.stl"), &cube(true));
+        let e = err_of(&args(), &d);
+        assert!(e.contains("holey.stl") && e.contains("closed"), "{e}");
+    }
+
+    #[test]
+    fn closed_meshes_load_and_one_parent_is_too_few() {
+        let d = tmp("meshes");
+        write_stl(&d.join("a.stl"), &cube(false));
+        std::fs::write(d.join("README.md"), "ignored").expect("write");
+        let e = err_of(&args(), &d);
+        assert!(
+            e.contains("1 usable parent") && e.contains("at least 2"),
+            "{e}"
+        );
+        write_stl(&d.join("b.stl"), &cube(false));
+        let l = load(&args(), &d).expect("two cubes");
+        assert_eq!((l.grids.len(), l.files, l.ignored), (2, 2, 1));
+        assert!(l.summary(&d).contains("2 usable grain(s)"));
+    }
+
+    #[test]
+    fn labelled_images_need_a_valid_spacing() {
+        let d = tmp("spacing");
+        let p = d.join("scan.npy");
+        write_npy(&p, &two_grains(6, false));
+        let mut a = args();
+        assert!(err_of(&a, &p).contains("--spacing"));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            a.spacing = Some(bad);
+            assert!(err_of(&a, &p).contains("finite and positive"), "{bad}");
+        }
+        a.spacing = Some(0.5);
+        let l = load(&a, &p).expect("two grains");
+        assert_eq!(l.names, ["label-1", "label-2"]);
+    }
+
+    #[test]
+    fn border_grains_small_grains_and_truncated_files_are_clear_errors() {
+        let d = tmp("labels");
+        let mut a = args();
+        a.spacing = Some(1.0);
+        // every label on the border
+        let p = d.join("border.npy");
+        write_npy(&p, &two_grains(6, true));
+        let e = err_of(&a, &p);
+        assert!(e.contains("border.npy") && e.contains("border"), "{e}");
+        // one-voxel grains
+        let mut img = levelset::LabelImage::zeros([9, 9, 9], 1.0).expect("image");
+        let (i1, i2) = (img.index(3, 3, 3), img.index(6, 6, 6));
+        img.labels[i1] = 1;
+        img.labels[i2] = 2;
+        let p = d.join("specks.npy");
+        write_npy(&p, &img);
+        let e = err_of(&a, &p);
+        assert!(e.contains("specks.npy"), "{e}");
+        // an empty image
+        let p = d.join("empty.npy");
+        write_npy(
+            &p,
+            &levelset::LabelImage::zeros([5, 5, 5], 1.0).expect("image"),
+        );
+        assert!(err_of(&a, &p).contains("empty.npy"));
+        // truncated
+        let p = d.join("cut.npy");
+        let mut buf = Vec::new();
+        levelset::io::write_npy(&mut buf, &two_grains(6, false), levelset::io::Dtype::U16)
+            .expect("npy");
+        buf.truncate(buf.len() - 7);
+        std::fs::write(&p, buf).expect("write");
+        assert!(err_of(&a, &p).contains("cut.npy"));
+        // raw without its layout
+        let p = d.join("scan.raw");
+        std::fs::write(&p, [0u8; 64]).expect("write");
+        assert!(err_of(&a, &p).contains("--raw-dims"));
+    }
+
+    #[test]
+    fn unknown_files_and_empty_directories_are_errors() {
+        let d = tmp("unknown");
+        assert!(err_of(&args(), &d).contains("no grain files"));
+        std::fs::write(d.join("grain.xyz"), "1 2 3").expect("write");
+        assert!(err_of(&args(), &d).contains("grain.xyz"));
+        assert!(err_of(&args(), &d.join("missing")).contains("missing"));
+    }
+
+    #[test]
+    fn nothing_is_half_written() {
+        let d = tmp("atomic");
+        let target = d.join("out.ron");
+        crate::progress::write_atomic(&target, b"first").expect("write");
+        // a folder in the way of the rename: the old file stays, no temp file is left
+        let blocked = d.join("dir");
+        std::fs::create_dir_all(blocked.join("x")).expect("dir");
+        assert!(crate::progress::write_atomic(&blocked, b"second").is_err());
+        let left: Vec<String> = std::fs::read_dir(&d)
+            .expect("list")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .collect();
+        assert!(left.iter().all(|n| !n.contains(".tmp-")), "{left:?}");
+        assert_eq!(std::fs::read(&target).expect("read"), b"first");
+    }
+}

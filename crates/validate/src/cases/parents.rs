@@ -40,6 +40,12 @@ pub(crate) fn cases() -> Vec<Case> {
             run: ottawa_representative,
         },
         Case {
+            name: "parents/ma107-6-calibrated",
+            description: "GSC 2.0 clones of the crushed aggregate MA107-6 (60 angular grains) at the configuration calibrated on it through the file path: average mean error <= 3 %, average std error <= 15 %, every KS <= 0.15 on 500 clones; committed scores reproduced",
+            fast: false,
+            run: ma107_calibrated,
+        },
+        Case {
             name: "parents/roundtrip-npy",
             description: "40 calibrated Ottawa clones painted into a labelled u16 .npy image (30 voxels across the median grain), written, read back and extracted as parents: image identical, every grain back, each DNA parameter within tolerances derived from h/D",
             fast: false,
@@ -447,4 +453,75 @@ fn roundtrip_stl() -> Result<Vec<Check>, Error> {
     )];
     dna_checks(&mut checks, own, &reread, hd, "h");
     Ok(checks)
+}
+
+/// The committed calibration of the crushed aggregate MA107-6 (written by
+/// `cargo xtask calibrate --parents fixtures/grains/vcctl/MA107-6-fine --out
+/// fixtures/calibrated/gsc2-ma107-6.ron --target-mean 3 --target-std 15
+/// --target-ks 0.15`), re-run on the embedded grains, built exactly as the
+/// file path builds them (45³ level sets of each file's own degree).
+fn ma107_calibrated() -> Result<Vec<Check>, Error> {
+    let name = "gsc2-ma107-6.ron";
+    let text = crate::fixtures::calibrated_files()
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, t)| *t)
+        .ok_or_else(|| Error::MissingFixture {
+            name: format!("calibrated/{name}"),
+        })?;
+    let cal = cloner::Calibrated::from_ron(text).map_err(err)?;
+    let parents = grains::vcctl_parents("vcctl/MA107-6-fine")?;
+    let model = cloner::CloneModel::fit(&parents, &cal.params).map_err(err)?;
+    let run = model
+        .run(0..cal.clones, cloner::Hooks::default())
+        .map_err(err)?;
+    let s = cloner::score(parents.dna(), &run.dna_table().map_err(err)?).map_err(err)?;
+    let mut out = Vec::new();
+    for (k, d) in cloner::TABLES_4_5.iter().enumerate() {
+        out.push(Check::new(
+            format!("{d} KS <= 0.15 (target; 5 % critical value for 60 vs 500 is 0.19)"),
+            0.15,
+            s.ks[k],
+            Tolerance::AtMost(0.0),
+        ));
+    }
+    out.extend([
+        Check::new(
+            "average mean error % <= 3 (target)",
+            3.0,
+            s.mean_error_avg_pct,
+            Tolerance::AtMost(0.0),
+        ),
+        Check::new(
+            "average std error % <= 15 (target)",
+            15.0,
+            s.std_error_avg_pct,
+            Tolerance::AtMost(0.0),
+        ),
+        Check::new(
+            "parents",
+            60.0,
+            parents.len() as f64,
+            Tolerance::Within(0.0),
+        ),
+        Check::new(
+            "clones >= 500",
+            500.0,
+            run.clones.len() as f64,
+            Tolerance::AtLeast(0.0),
+        ),
+        Check::new(
+            "average mean error reproduces the committed calibration",
+            cal.scores.mean_error_avg_pct,
+            s.mean_error_avg_pct,
+            Tolerance::Relative(1e-6),
+        ),
+        Check::new(
+            "candidates drawn reproduce the committed calibration",
+            cal.attempts as f64,
+            run.stats.attempts as f64,
+            Tolerance::Within(0.0),
+        ),
+    ]);
+    Ok(out)
 }
