@@ -663,8 +663,7 @@ impl Calibrate {
         match &self.source.parents {
             None => {
                 eprintln!(
-                    "preparing the default parents: {} Ottawa-sand grains drawn at random from NIST's population (45³ level sets, DNA)…",
-                    "71"
+                    "preparing the default parents: Ottawa-sand grains drawn at random from NIST's population (45³ level sets, DNA)…"
                 );
                 let parents = validate::grains::ottawa_parents()?;
                 let material = Material {

@@ -257,12 +257,14 @@ pub const ROUNDTRIP_CLONES: u64 = 40;
 /// round trips (a typical CT resolution for sand: 20–40 voxels per grain).
 pub const ROUNDTRIP_VOXELS_PER_DIAMETER: f64 = 30.0;
 
-fn roundtrip_clones() -> Result<&'static (Vec<levelset::Grid>, Vec<Vec<f64>>), Error> {
-    static CLONES: std::sync::OnceLock<Result<(Vec<levelset::Grid>, Vec<Vec<f64>>), String>> =
-        std::sync::OnceLock::new();
+/// Level sets of clones and their own DNA rows.
+type GridsAndDna = (Vec<levelset::Grid>, Vec<Vec<f64>>);
+
+fn roundtrip_clones() -> Result<&'static GridsAndDna, Error> {
+    static CLONES: std::sync::OnceLock<Result<GridsAndDna, String>> = std::sync::OnceLock::new();
     CLONES
         .get_or_init(|| {
-            let run = || -> Result<(Vec<levelset::Grid>, Vec<Vec<f64>>), Error> {
+            let run = || -> Result<GridsAndDna, Error> {
                 let text = crate::fixtures::calibrated_files()
                     .iter()
                     .find(|(n, _)| *n == "gsc2-ottawa.ron")
