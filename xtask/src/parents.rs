@@ -48,6 +48,18 @@ pub(crate) enum InputFormat {
 }
 
 impl InputFormat {
+    /// File extensions of the format (lower case).
+    fn extensions(self) -> &'static [&'static str] {
+        match self {
+            Self::Npy => &["npy"],
+            Self::Tiff => &["tif", "tiff"],
+            Self::Raw => &["raw", "bin"],
+            Self::Stl => &["stl"],
+            Self::Obj => &["obj"],
+            Self::Anm | Self::Morph => &["dat", "anm", "morph"],
+        }
+    }
+
     fn name(self) -> &'static str {
         match self {
             Self::Npy => "NumPy labelled image",
@@ -69,7 +81,8 @@ pub(crate) struct ParentArgs {
     /// LS-DEM morph). Default: the embedded Ottawa-sand parents.
     #[arg(long, value_name = "PATH")]
     pub(crate) parents: Option<PathBuf>,
-    /// Input format (default: from the extension and contents).
+    /// Input format (default: from the extension and contents). In a
+    /// directory, only files with this format's extensions are read.
     #[arg(long, value_enum)]
     pub(crate) format: Option<InputFormat>,
     /// Voxel spacing of a labelled image, in the physical unit of the output
@@ -261,8 +274,11 @@ pub(crate) fn load(args: &ParentArgs, source: &Path) -> anyhow::Result<Loaded> {
     let mut ignored = 0usize;
     let mut format: Option<(InputFormat, PathBuf)> = None;
     for p in entries {
+        // with --format, files of that format's extensions are read and the
+        // rest ignored (e.g. the .dat of a clone folder that also holds STL);
+        // without it, every file is classified and a mix is an error
         let f = match args.format {
-            Some(f) if !IGNORED_EXT.contains(&ext(&p).as_str()) => Some(f),
+            Some(f) if f.extensions().contains(&ext(&p).as_str()) => Some(f),
             Some(_) => None,
             None => classify(&p)?,
         };
