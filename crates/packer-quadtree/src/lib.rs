@@ -58,14 +58,19 @@
 // Seeded randomised tests print their seed (house style).
 #![cfg_attr(test, allow(clippy::print_stdout))]
 
+pub mod contact2d;
+pub mod contact3d;
 mod domain;
 mod error;
 mod ga;
+pub mod gap;
 mod grading;
 mod index;
 mod io;
 mod metrics;
 mod packer;
+mod pic;
+mod shapes;
 
 pub use domain::Domain;
 pub use error::{Error, Result};
@@ -76,6 +81,10 @@ pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};
 pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };
+pub use pic::{
+    ContactMethod, PicPacking, PicParams, PicReport, Placed, check_pic, pack_pic,
+};
+pub use shapes::{Geometry, Grain, GrainShape, ParryConvex, Swept};
 pub use packer::{
     BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,
     pack_sizes, pack_sizes_with_index, pack_with_index,
