@@ -42,19 +42,26 @@ const TANGENCY: f64 = 64.0 * f64::EPSILON;
 /// touching the three fixed objects.
 #[must_use]
 pub fn intersect(w: &[Wrapper3; 3]) -> Solutions<Point3<f64>> {
-    let mut spheres: Vec<(Point3<f64>, f64)> = Vec::with_capacity(3);
-    let mut planes: Vec<(Vector3<f64>, f64)> = Vec::with_capacity(3);
+    let mut sph = [(Point3::origin(), 0.0); 3];
+    let mut pl = [(Vector3::zeros(), 0.0); 3];
+    let (mut ns, mut np) = (0, 0);
     for x in w {
         match *x {
             Wrapper3::Sphere { centre, radius } => {
                 if !(radius > 0.0) || !radius.is_finite() {
                     return Solutions::none();
                 }
-                spheres.push((centre, radius));
+                sph[ns] = (centre, radius);
+                ns += 1;
             }
-            Wrapper3::Plane { normal, offset } => planes.push((normal.into_inner(), offset)),
+            Wrapper3::Plane { normal, offset } => {
+                pl[np] = (normal.into_inner(), offset);
+                np += 1;
+            }
         }
     }
+    let spheres = &sph[..ns];
+    let planes = &pl[..np];
     if spheres.is_empty() {
         let m = Matrix3::from_rows(&[
             planes[0].0.transpose(),
@@ -74,17 +81,20 @@ pub fn intersect(w: &[Wrapper3; 3]) -> Solutions<Point3<f64>> {
     }
     let (c0, rho0) = spheres[0];
     let scale = spheres.iter().map(|s| s.1).fold(0.0, f64::max);
-    let mut lin: Vec<(Vector3<f64>, f64)> = Vec::with_capacity(2);
+    let mut lin = [(Vector3::zeros(), 0.0); 2];
+    let mut nl = 0;
     for &(c, rho) in &spheres[1..] {
         let a = c - c0;
         let d2 = a.norm_squared();
         if d2 <= (1e-12 * scale).powi(2) {
             return Solutions::none();
         }
-        lin.push((a, 0.5 * (rho0 * rho0 - rho * rho + d2)));
+        lin[nl] = (a, 0.5 * (rho0 * rho0 - rho * rho + d2));
+        nl += 1;
     }
-    for &(n, o) in &planes {
-        lin.push((n, o - n.dot(&c0.coords)));
+    for &(n, o) in planes {
+        lin[nl] = (n, o - n.dot(&c0.coords));
+        nl += 1;
     }
     let (a1, b1) = lin[0];
     let (a2, b2) = lin[1];

@@ -24,7 +24,6 @@
 //! `≥ −1e-10·R_mob`; contacts are solved to `1e-13·R_mob` (closed forms
 //! and Newton) or `1e-10·R_mob` (Nelder–Mead).
 
-use std::cell::Cell;
 use std::collections::BTreeSet;
 
 use nalgebra::{Point2, Point3, SVector, Unit};
@@ -68,6 +67,13 @@ pub struct PicParams {
     pub method: ContactMethod,
     /// Stop after this many placed grains.
     pub max_grains: usize,
+    /// How many grains nearest to the front grain may be contact partners
+    /// (with the walls); more is slower and slightly denser.
+    pub neighbours: usize,
+    /// Orientations tried per grain (the drawn one first; the lowest
+    /// placement wins). 1 keeps every grain's random orientation, as the
+    /// seed's "without making rotations".
+    pub orientations: usize,
 }
 
 impl Default for PicParams {
@@ -81,6 +87,8 @@ impl Default for PicParams {
             shape: GrainShape::Capsule { aspect: 0.5 },
             method: ContactMethod::Newton,
             max_grains: 1_000_000,
+            neighbours: 16,
+            orientations: 1,
         }
     }
 }
@@ -223,6 +231,7 @@ struct Packer<'a, const D: usize> {
     grid: Grid<D>,
     rmax_placed: f64,
     tol_rel: f64,
+    neighbours: usize,
 }
 
 impl<const D: usize> Packer<'_, D> {
@@ -272,83 +281,103 @@ impl<const D: usize> Packer<'_, D> {
         ok
     }
 
-    /// Contact positions of `m` touching the `D` objects `set`.
-    fn solve(&self, set: &[Obj], m: &Grain<D>, out: &mut Vec<SVector<f64, D>>) {
+    /// First guesses of the contact positions of `m` touching the `D`
+    /// objects `set`; `true` when they are exact (closed forms).
+    fn guesses(&self, set: &[Obj], m: &Grain<D>, out: &mut Vec<SVector<f64, D>>) -> bool {
         out.clear();
-        let method = self.params.method;
-        let all_balls = m.is_ball()
-            && set.iter().all(|o| match o {
-                Obj::Grain(i) => self.grains[*i as usize].grain.is_ball(),
+        let is = |f: fn(&Grain<D>) -> bool| {
+            f(m) && set.iter().all(|o| match o {
+                Obj::Grain(i) => f(&self.grains[*i as usize].grain),
                 Obj::Wall { .. } => true,
-            });
-        if all_balls {
+            })
+        };
+        let mut w = [Wrap::Plane(SVector::zeros(), 0.0); 3];
+        if is(Grain::is_ball) {
             let r = m.circumradius;
-            let w: Vec<Wrap<D>> = set.iter().map(|&o| self.wrap(o, r, &SVector::zeros(), r)).collect();
-            intersect(&w, out);
-            return;
-        }
-        let clusters = m.is_sphere_cluster()
-            && set.iter().all(|o| match o {
-                Obj::Grain(i) => self.grains[*i as usize].grain.is_sphere_cluster(),
-                Obj::Wall { .. } => true,
-            });
-        if method == ContactMethod::Wrappers && clusters {
-            self.cluster_wrappers(set, m, out);
-            return;
-        }
-        // First guesses: closed form with effective radii (mean of in- and
-        // circumscribed), then Newton or Nelder–Mead on the exact gaps.
-        let eff = |g: &Grain<D>| 0.5 * (g.inradius + g.circumradius);
-        let rm = eff(m);
-        let w: Vec<Wrap<D>> = set
-            .iter()
-            .map(|&o| {
+            for (k, &o) in set.iter().enumerate() {
                 let rf = match o {
-                    Obj::Grain(i) => eff(&self.grains[i as usize].grain),
+                    Obj::Grain(i) => self.grains[i as usize].grain.circumradius,
                     Obj::Wall { .. } => 0.0,
                 };
-                self.wrap(o, rf + rm, &SVector::zeros(), rm)
-            })
-            .collect();
-        let mut starts = Vec::with_capacity(2);
-        intersect(&w, &mut starts);
-        let obstacles: Vec<Obstacle<'_, D>> = set.iter().map(|&o| self.obstacle(o)).collect();
-        let tol = 1e-13 * m.circumradius;
-        for (k, s) in starts.iter().enumerate() {
-            let x = match method {
-                ContactMethod::NelderMead => {
-                    let side = self.side_restriction(set, s, &starts, k);
-                    gap::nelder_mead(&obstacles, m, *s, side, 1e-10 * m.circumradius)
-                }
-                _ => gap::newton(&obstacles, m, *s, tol),
-            };
-            if let Some(x) = x {
-                if !out.iter().any(|q| (q - x).norm() <= 1e-9 * m.circumradius) {
-                    out.push(x);
-                }
+                w[k] = self.wrap(o, rf + r, &SVector::zeros(), r);
             }
+            intersect(&w[..D], out);
+            return true;
+        }
+        if self.params.method == ContactMethod::Wrappers && is(Grain::is_sphere_cluster) {
+            self.cluster_wrappers(set, m, out);
+            return true;
+        }
+        // Closed form with effective radii (mean of in- and circumscribed).
+        let eff = |g: &Grain<D>| 0.5 * (g.inradius + g.circumradius);
+        let rm = eff(m);
+        for (k, &o) in set.iter().enumerate() {
+            let rf = match o {
+                Obj::Grain(i) => eff(&self.grains[i as usize].grain),
+                Obj::Wall { .. } => 0.0,
+            };
+            w[k] = self.wrap(o, rf + rm, &SVector::zeros(), rm);
+        }
+        intersect(&w[..D], out);
+        false
+    }
+
+    /// The exact contact position of `m` touching `set`, from a first guess
+    /// (Newton's method, or the seed's Nelder–Mead).
+    fn refine(&self, set: &[Obj], m: &Grain<D>, guess: &SVector<f64, D>) -> Option<SVector<f64, D>> {
+        let mut obstacles = [Obstacle::Wall {
+            axis: 0,
+            at: 0.0,
+            upper: false,
+        }; 3];
+        for (k, &o) in set.iter().enumerate() {
+            obstacles[k] = self.obstacle(o);
+        }
+        match self.params.method {
+            ContactMethod::NelderMead => {
+                let side = self.side_restriction(set, guess);
+                gap::nelder_mead(&obstacles[..D], m, *guess, side, 1e-10 * m.circumradius)
+            }
+            _ => gap::newton(&obstacles[..D], m, *guess, 1e-13 * m.circumradius),
         }
     }
 
-    /// The seed's half-space restriction for the `k`-th of two first
-    /// guesses: the side of the line/plane through the first guesses'
-    /// midpoint normal to their difference.
+    /// The seed's half-space restriction (§3.2): the side, where `guess`
+    /// lies, of the line (2D) or plane (3D) through the obstacles'
+    /// reference points (a wall contributes the foot of `guess` on it).
     fn side_restriction(
         &self,
-        _set: &[Obj],
-        s: &SVector<f64, D>,
-        starts: &[SVector<f64, D>],
-        k: usize,
+        set: &[Obj],
+        guess: &SVector<f64, D>,
     ) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
-        if starts.len() < 2 {
+        let pts: Vec<SVector<f64, D>> = set
+            .iter()
+            .map(|&o| match o {
+                Obj::Grain(i) => self.grains[i as usize].centre,
+                Obj::Wall { axis, upper } => {
+                    let mut q = *guess;
+                    q[axis] = if upper { self.params.side } else { 0.0 };
+                    q
+                }
+            })
+            .collect();
+        let mut n = SVector::<f64, D>::zeros();
+        if D == 2 {
+            let d = pts[1] - pts[0];
+            n[0] = -d[1];
+            n[1] = d[0];
+        } else {
+            let a = pts[1] - pts[0];
+            let b = pts[2] - pts[0];
+            n[0] = a[1] * b[2] - a[2] * b[1];
+            n[1] = a[2] * b[0] - a[0] * b[2];
+            n[2] = a[0] * b[1] - a[1] * b[0];
+        }
+        let s = n.dot(&(guess - pts[0]));
+        if n.norm() == 0.0 || s == 0.0 {
             return None;
         }
-        let other = starts[1 - k.min(1)];
-        let n = s - other;
-        if n.norm() == 0.0 {
-            return None;
-        }
-        Some((n, (s + other) * 0.5))
+        Some((n * s.signum(), pts[0]))
     }
 
     /// Wrapper of object `o` for a mobile element of radius `r_elem` at
@@ -387,20 +416,26 @@ impl<const D: usize> Packer<'_, D> {
         let mut idx = vec![(0usize, 0usize); D];
         let mut tmp = Vec::with_capacity(2);
         loop {
-            let w: Vec<Wrap<D>> = (0..D)
-                .map(|k| {
-                    let (ai, mi) = idx[k];
-                    let (c, r) = lists[k][ai];
-                    let e = me[mi];
-                    match set[k] {
-                        Obj::Grain(_) => Wrap::Sphere(c - e.a, r + e.radius),
-                        Obj::Wall { .. } => self.wrap(set[k], 0.0, &e.a, e.radius),
-                    }
-                })
-                .collect();
-            intersect(&w, &mut tmp);
+            let mut w = [Wrap::Plane(SVector::zeros(), 0.0); 3];
+            for k in 0..D {
+                let (ai, mi) = idx[k];
+                let (c, r) = lists[k][ai];
+                let e = me[mi];
+                w[k] = match set[k] {
+                    Obj::Grain(_) => Wrap::Sphere(c - e.a, r + e.radius),
+                    Obj::Wall { .. } => self.wrap(set[k], 0.0, &e.a, e.radius),
+                };
+            }
+            intersect(&w[..D], &mut tmp);
+            // The seed's filter: discard positions overlapping a grain of
+            // the set itself.
+            let tol = self.tol_rel * m.circumradius;
             for x in &tmp {
-                if !out.iter().any(|q| (q - x).norm() <= 1e-9 * m.circumradius) {
+                let own_ok = set.iter().all(|&o| match o {
+                    Obj::Grain(_) => gap::gap(&self.obstacle(o), m, x).is_some_and(|(g, _)| g >= -tol),
+                    Obj::Wall { .. } => true,
+                });
+                if own_ok && !out.iter().any(|q| (q - x).norm() <= 1e-9 * m.circumradius) {
                     out.push(*x);
                 }
             }
@@ -425,55 +460,40 @@ impl<const D: usize> Packer<'_, D> {
         }
     }
 
-    /// The lowest feasible position of `m` touching `P = grains[p]`.
+    /// The lowest feasible position of `m` touching `P = grains[p]`: the
+    /// `neighbours` grains nearest to `P` (surface distance) and the walls
+    /// within reach form the sets; their first guesses are sorted by height
+    /// and refined in that order until a guess is higher than the best
+    /// position found plus a margin (`0` for closed forms, `R_mob/2` else).
     fn around(&self, p: u32, m: &Grain<D>) -> Option<SVector<f64, D>> {
         let pc = self.grains[p as usize].centre;
         let pr = self.grains[p as usize].grain.circumradius;
         let rm = m.circumradius;
         let last = D - 1;
-        let mut objs: Vec<(Obj, f64)> = Vec::new();
+        let mut near: Vec<(f64, u32)> = Vec::new();
         self.grid.query(&pc, pr + self.rmax_placed + 2.0 * rm, |id| {
             if id == p {
                 return;
             }
             let q = &self.grains[id as usize];
-            let reach = pr + q.grain.circumradius + 2.0 * rm;
-            if (q.centre - pc).norm_squared() <= reach * reach {
-                objs.push((Obj::Grain(id), q.centre[last] - q.grain.circumradius - rm));
+            let d = (q.centre - pc).norm();
+            if d <= pr + q.grain.circumradius + 2.0 * rm {
+                near.push((d - q.grain.circumradius, id));
             }
         });
+        near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        near.truncate(self.neighbours);
+        let mut objs: Vec<Obj> = near.iter().map(|&(_, id)| Obj::Grain(id)).collect();
         for axis in 0..D {
             for upper in [false, true] {
                 let d = if upper { self.params.side - pc[axis] } else { pc[axis] };
                 if d <= pr + 2.0 * rm {
-                    let lb = if axis == last && upper {
-                        self.params.side - 2.0 * rm
-                    } else {
-                        f64::NEG_INFINITY
-                    };
-                    objs.push((Obj::Wall { axis, upper }, lb));
+                    objs.push(Obj::Wall { axis, upper });
                 }
             }
         }
-        objs.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let lb_p = pc[last] - pr - rm;
-        let best: Cell<Option<SVector<f64, D>>> = Cell::new(None);
-        let best_h = Cell::new(f64::INFINITY);
-        let mut sols = Vec::with_capacity(4);
-        let consider = |set: &[Obj], lb: f64, sols: &mut Vec<SVector<f64, D>>| {
-            if lb >= best_h.get() {
-                return;
-            }
-            self.solve(set, m, sols);
-            for x in sols.iter() {
-                if x[last] < best_h.get() && self.feasible(m, x) {
-                    best_h.set(x[last]);
-                    best.set(Some(*x));
-                }
-            }
-        };
-        let reach_pair = |a: (Obj, f64), b: (Obj, f64)| -> bool {
-            match (a.0, b.0) {
+        let reach_pair = |a: Obj, b: Obj| -> bool {
+            match (a, b) {
                 (Obj::Grain(i), Obj::Grain(j)) => {
                     let (gi, gj) = (&self.grains[i as usize], &self.grains[j as usize]);
                     let reach = gi.grain.circumradius + gj.grain.circumradius + 2.0 * rm;
@@ -493,27 +513,48 @@ impl<const D: usize> Packer<'_, D> {
             }
         };
         let pobj = Obj::Grain(p);
+        let mut cands: Vec<(f64, [Obj; 3], SVector<f64, D>, bool)> = Vec::new();
+        let mut tmp = Vec::with_capacity(4);
+        let mut add = |set: [Obj; 3], tmp: &mut Vec<SVector<f64, D>>| {
+            let exact = self.guesses(&set[..D], m, tmp);
+            for x in tmp.iter() {
+                cands.push((x[last], set, *x, exact));
+            }
+        };
         if D == 2 {
             for &a in &objs {
-                consider(&[pobj, a.0], lb_p.max(a.1), &mut sols);
+                add([pobj, a, a], &mut tmp);
             }
         } else {
             for (i, &a) in objs.iter().enumerate() {
-                if lb_p.max(a.1) >= best_h.get() {
-                    break;
-                }
                 for &b in &objs[i + 1..] {
-                    let lb = lb_p.max(a.1).max(b.1);
-                    if lb >= best_h.get() {
-                        break;
-                    }
                     if reach_pair(a, b) {
-                        consider(&[pobj, a.0, b.0], lb, &mut sols);
+                        add([pobj, a, b], &mut tmp);
                     }
                 }
             }
         }
-        best.get()
+        cands.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut best: Option<SVector<f64, D>> = None;
+        let mut best_h = f64::INFINITY;
+        for (h, set, g, exact) in cands {
+            let margin = if exact { 0.0 } else { 0.5 * rm };
+            if h >= best_h + margin {
+                break;
+            }
+            let x = if exact {
+                Some(g)
+            } else {
+                self.refine(&set[..D], m, &g)
+            };
+            if let Some(x) = x {
+                if x[last] < best_h && self.feasible(m, &x) {
+                    best_h = x[last];
+                    best = Some(x);
+                }
+            }
+        }
+        best
     }
 
     fn place(&mut self, x: SVector<f64, D>, g: Grain<D>) -> u32 {
@@ -593,14 +634,22 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
         grid: Grid::new(params.side, 2.0 * params.radius_max),
         rmax_placed: 0.0,
         tol_rel: 1e-10,
+        neighbours: params.neighbours,
     };
-    let draw = |i: u64| -> Result<Grain<D>> {
+    // Grain `i`: its size, then `orientations` orientations of it, all
+    // from the stream (seed, i).
+    let draw = |i: u64| -> Result<Vec<Grain<D>>> {
         let mut rng = stream(seed, i);
         let r = params.radius_min + (params.radius_max - params.radius_min) * rng.random::<f64>();
-        params.shape.sample::<D>(r, &mut rng)
+        let k = if params.shape == GrainShape::Ball {
+            1
+        } else {
+            params.orientations.max(1)
+        };
+        (0..k).map(|_| params.shape.sample::<D>(r, &mut rng)).collect()
     };
     let mut front: BTreeSet<(u64, u32)> = BTreeSet::new();
-    let first = draw(0)?;
+    let first = draw(0)?.swap_remove(0);
     let x0 = -first.lo;
     if !pk.feasible(&first, &x0) {
         return Err(Error::DomainTooSmall {
@@ -610,37 +659,55 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
     }
     let id = pk.place(x0, first);
     front.insert((key(x0[D - 1]), id));
+    // Smallest circumscribed radius that failed around each front grain:
+    // larger grains skip it.
+    let mut failed_r: Vec<f64> = vec![f64::INFINITY];
     let mut index = 1u64;
     let mut rejects_in_row = 0usize;
     let mut rejected = 0usize;
     while pk.grains.len() < params.max_grains && !front.is_empty() && rejects_in_row < 400 {
-        let m = draw(index)?;
+        let mut ms = draw(index)?;
         index += 1;
-        let mut placed = None;
+        let big_r = ms[0].circumradius;
+        let mut placed: Option<(SVector<f64, D>, usize)> = None;
         let mut cursor: Option<(u64, u32)> = None;
         let mut tries = 0;
         while tries < 32 {
             let next = match cursor {
                 None => front.iter().next().copied(),
-                Some(c) => front.range((std::ops::Bound::Excluded(c), std::ops::Bound::Unbounded)).next().copied(),
+                Some(c) => front
+                    .range((std::ops::Bound::Excluded(c), std::ops::Bound::Unbounded))
+                    .next()
+                    .copied(),
             };
             let Some(entry) = next else { break };
-            if let Some(x) = pk.around(entry.1, &m) {
-                placed = Some(x);
+            cursor = Some(entry);
+            if big_r >= failed_r[entry.1 as usize] {
+                continue;
+            }
+            tries += 1;
+            for (k, m) in ms.iter().enumerate() {
+                if let Some(x) = pk.around(entry.1, m) {
+                    if placed.is_none_or(|(b, _)| x[D - 1] < b[D - 1]) {
+                        placed = Some((x, k));
+                    }
+                }
+            }
+            if placed.is_some() {
                 break;
             }
+            failed_r[entry.1 as usize] = big_r;
             // Does the smallest grain of this orientation fit around P?
-            let small = scaled(&m, params.radius_min / m.circumradius);
+            let small = scaled(&ms[0], params.radius_min / big_r);
             let keep = small.as_ref().is_some_and(|s| pk.around(entry.1, s).is_some());
             if !keep {
                 front.remove(&entry);
             }
-            cursor = Some(entry);
-            tries += 1;
         }
         match placed {
-            Some(x) => {
-                let id = pk.place(x, m);
+            Some((x, k)) => {
+                let id = pk.place(x, ms.swap_remove(k));
+                failed_r.push(f64::INFINITY);
                 front.insert((key(x[D - 1]), id));
                 rejects_in_row = 0;
             }
