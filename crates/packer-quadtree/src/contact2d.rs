@@ -97,7 +97,16 @@ const TANGENCY: f64 = 64.0 * f64::EPSILON;
 pub fn intersect(a: &Wrapper2, b: &Wrapper2) -> Solutions<Point2<f64>> {
     use Wrapper2::{Circle, Line};
     match (*a, *b) {
-        (Line { normal: n1, offset: o1 }, Line { normal: n2, offset: o2 }) => {
+        (
+            Line {
+                normal: n1,
+                offset: o1,
+            },
+            Line {
+                normal: n2,
+                offset: o2,
+            },
+        ) => {
             let det = n1.x * n2.y - n1.y * n2.x;
             if det.abs() <= 1e-12 {
                 return Solutions::none();
@@ -143,12 +152,7 @@ pub fn intersect(a: &Wrapper2, b: &Wrapper2) -> Solutions<Point2<f64>> {
 }
 
 /// Points `c + y` with `a·y = b` and `|y| = rho` (`a ≠ 0`).
-fn solve_line_circle(
-    c: Point2<f64>,
-    rho: f64,
-    a: Vector2<f64>,
-    b: f64,
-) -> Solutions<Point2<f64>> {
+fn solve_line_circle(c: Point2<f64>, rho: f64, a: Vector2<f64>, b: f64) -> Solutions<Point2<f64>> {
     let aa = a.norm_squared();
     if !(aa > 0.0) || !aa.is_finite() || !b.is_finite() {
         return Solutions::none();
@@ -310,9 +314,9 @@ pub fn cluster_two_clusters(
                         radius: r2 + s2,
                     };
                     for x in intersect(&w1, &w2).iter() {
-                        let ok = [fixed1, fixed2].iter().all(|f| {
-                            cluster_gap(f, mobile, x) >= -tol
-                        });
+                        let ok = [fixed1, fixed2]
+                            .iter()
+                            .all(|f| cluster_gap(f, mobile, x) >= -tol);
                         if ok && !out.iter().any(|q| (q - x).norm() <= 1e-9 * scale) {
                             out.push(x);
                         }
@@ -327,7 +331,11 @@ pub fn cluster_two_clusters(
 /// Smallest signed gap between a fixed cluster and a mobile cluster placed
 /// at `x`.
 #[must_use]
-pub fn cluster_gap(fixed: &[(Point2<f64>, f64)], mobile: &[(Vector2<f64>, f64)], x: Point2<f64>) -> f64 {
+pub fn cluster_gap(
+    fixed: &[(Point2<f64>, f64)],
+    mobile: &[(Vector2<f64>, f64)],
+    x: Point2<f64>,
+) -> f64 {
     let mut g = f64::INFINITY;
     for &(c, r) in fixed {
         for &(m, s) in mobile {
@@ -359,7 +367,10 @@ pub fn convex_polygon(vertices: &[Point2<f64>]) -> Result<Vec<Point2<f64>>> {
     for i in 0..n {
         for j in i + 1..n {
             if (vertices[i] - vertices[j]).norm() <= 1e-12 * scale {
-                return Err(Error::RepeatedVertex { first: i, second: j });
+                return Err(Error::RepeatedVertex {
+                    first: i,
+                    second: j,
+                });
             }
         }
     }

@@ -150,7 +150,11 @@ fn swept_contact<const D: usize>(
         ParryConvex::Polygon(poly) => {
             let p1 = parry2d_f64::math::Pose::translation(at_convex[0], at_convex[1]);
             let p2 = parry2d_f64::math::Pose::translation(at_e[0], at_e[1]);
-            let cap = parry2d_f64::shape::Capsule::new(to_p2(e.a.as_slice()), to_p2(e.b.as_slice()), e.radius);
+            let cap = parry2d_f64::shape::Capsule::new(
+                to_p2(e.a.as_slice()),
+                to_p2(e.b.as_slice()),
+                e.radius,
+            );
             let ball = parry2d_f64::shape::Ball::new(e.radius);
             let s2: &dyn parry2d_f64::shape::Shape = if e.a == e.b { &ball } else { &cap };
             let pe = if e.a == e.b {
@@ -168,11 +172,19 @@ fn swept_contact<const D: usize>(
         }
         ParryConvex::Polyhedron(poly) => {
             let p1 = parry3d_f64::math::Pose::translation(at_convex[0], at_convex[1], at_convex[2]);
-            let cap = parry3d_f64::shape::Capsule::new(to_p3(e.a.as_slice()), to_p3(e.b.as_slice()), e.radius);
+            let cap = parry3d_f64::shape::Capsule::new(
+                to_p3(e.a.as_slice()),
+                to_p3(e.b.as_slice()),
+                e.radius,
+            );
             let ball = parry3d_f64::shape::Ball::new(e.radius);
             let s2: &dyn parry3d_f64::shape::Shape = if e.a == e.b { &ball } else { &cap };
             let pe = if e.a == e.b {
-                parry3d_f64::math::Pose::translation(at_e[0] + e.a[0], at_e[1] + e.a[1], at_e[2] + e.a[2])
+                parry3d_f64::math::Pose::translation(
+                    at_e[0] + e.a[0],
+                    at_e[1] + e.a[1],
+                    at_e[2] + e.a[2],
+                )
             } else {
                 parry3d_f64::math::Pose::translation(at_e[0], at_e[1], at_e[2])
             };
@@ -198,13 +210,15 @@ fn convex_convex<const D: usize>(
         (ParryConvex::Polygon(pa), ParryConvex::Polygon(pb)) => {
             let p1 = parry2d_f64::math::Pose::translation(at_a[0], at_a[1]);
             let p2 = parry2d_f64::math::Pose::translation(at_b[0], at_b[1]);
-            let c = parry2d_f64::query::contact(&p1, pa.as_ref(), &p2, pb.as_ref(), pred).ok()??;
+            let c =
+                parry2d_f64::query::contact(&p1, pa.as_ref(), &p2, pb.as_ref(), pred).ok()??;
             Some((c.dist, SVector::from_fn(|i, _| c.normal1[i])))
         }
         (ParryConvex::Polyhedron(pa), ParryConvex::Polyhedron(pb)) => {
             let p1 = parry3d_f64::math::Pose::translation(at_a[0], at_a[1], at_a[2]);
             let p2 = parry3d_f64::math::Pose::translation(at_b[0], at_b[1], at_b[2]);
-            let c = parry3d_f64::query::contact(&p1, pa.as_ref(), &p2, pb.as_ref(), pred).ok()??;
+            let c =
+                parry3d_f64::query::contact(&p1, pa.as_ref(), &p2, pb.as_ref(), pred).ok()??;
             Some((c.dist, SVector::from_fn(|i, _| c.normal1[i])))
         }
         _ => None,
@@ -301,7 +315,11 @@ pub fn newton<const D: usize>(
             return None;
         }
         let n = step.norm();
-        x += if n > max_step { step * (max_step / n) } else { step };
+        x += if n > max_step {
+            step * (max_step / n)
+        } else {
+            step
+        };
     }
     None
 }

@@ -81,11 +81,9 @@ pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};
 pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };
-pub use pic::{
-    ContactMethod, PicPacking, PicParams, PicReport, Placed, check_pic, pack_pic,
-};
-pub use shapes::{Geometry, Grain, GrainShape, ParryConvex, Swept};
 pub use packer::{
     BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,
     pack_sizes, pack_sizes_with_index, pack_with_index,
 };
+pub use pic::{ContactMethod, PicPacking, PicParams, PicReport, Placed, check_pic, pack_pic};
+pub use shapes::{Geometry, Grain, GrainShape, ParryConvex, Swept};

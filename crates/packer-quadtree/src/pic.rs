@@ -324,7 +324,12 @@ impl<const D: usize> Packer<'_, D> {
 
     /// The exact contact position of `m` touching `set`, from a first guess
     /// (Newton's method, or the seed's Nelder–Mead).
-    fn refine(&self, set: &[Obj], m: &Grain<D>, guess: &SVector<f64, D>) -> Option<SVector<f64, D>> {
+    fn refine(
+        &self,
+        set: &[Obj],
+        m: &Grain<D>,
+        guess: &SVector<f64, D>,
+    ) -> Option<SVector<f64, D>> {
         let mut obstacles = [Obstacle::Wall {
             axis: 0,
             at: 0.0,
@@ -387,7 +392,11 @@ impl<const D: usize> Packer<'_, D> {
             Obj::Grain(i) => Wrap::Sphere(self.grains[i as usize].centre - m_off, rho),
             Obj::Wall { axis, upper } => {
                 let mut n = SVector::<f64, D>::zeros();
-                let (sign, at) = if upper { (-1.0, self.params.side) } else { (1.0, 0.0) };
+                let (sign, at) = if upper {
+                    (-1.0, self.params.side)
+                } else {
+                    (1.0, 0.0)
+                };
                 n[axis] = sign;
                 // n·(x + m_off) = sign·at + r_elem.
                 Wrap::Plane(n, sign * at + r_elem - n.dot(m_off))
@@ -432,7 +441,9 @@ impl<const D: usize> Packer<'_, D> {
             let tol = self.tol_rel * m.circumradius;
             for x in &tmp {
                 let own_ok = set.iter().all(|&o| match o {
-                    Obj::Grain(_) => gap::gap(&self.obstacle(o), m, x).is_some_and(|(g, _)| g >= -tol),
+                    Obj::Grain(_) => {
+                        gap::gap(&self.obstacle(o), m, x).is_some_and(|(g, _)| g >= -tol)
+                    }
                     Obj::Wall { .. } => true,
                 });
                 if own_ok && !out.iter().any(|q| (q - x).norm() <= 1e-9 * m.circumradius) {
@@ -471,22 +482,27 @@ impl<const D: usize> Packer<'_, D> {
         let rm = m.circumradius;
         let last = D - 1;
         let mut near: Vec<(f64, u32)> = Vec::new();
-        self.grid.query(&pc, pr + self.rmax_placed + 2.0 * rm, |id| {
-            if id == p {
-                return;
-            }
-            let q = &self.grains[id as usize];
-            let d = (q.centre - pc).norm();
-            if d <= pr + q.grain.circumradius + 2.0 * rm {
-                near.push((d - q.grain.circumradius, id));
-            }
-        });
+        self.grid
+            .query(&pc, pr + self.rmax_placed + 2.0 * rm, |id| {
+                if id == p {
+                    return;
+                }
+                let q = &self.grains[id as usize];
+                let d = (q.centre - pc).norm();
+                if d <= pr + q.grain.circumradius + 2.0 * rm {
+                    near.push((d - q.grain.circumradius, id));
+                }
+            });
         near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         near.truncate(self.neighbours);
         let mut objs: Vec<Obj> = near.iter().map(|&(_, id)| Obj::Grain(id)).collect();
         for axis in 0..D {
             for upper in [false, true] {
-                let d = if upper { self.params.side - pc[axis] } else { pc[axis] };
+                let d = if upper {
+                    self.params.side - pc[axis]
+                } else {
+                    pc[axis]
+                };
                 if d <= pr + 2.0 * rm {
                     objs.push(Obj::Wall { axis, upper });
                 }
@@ -561,7 +577,10 @@ impl<const D: usize> Packer<'_, D> {
         let id = self.grains.len() as u32;
         self.rmax_placed = self.rmax_placed.max(g.circumradius);
         self.grid.insert(&x, id);
-        self.grains.push(Placed { centre: x, grain: g });
+        self.grains.push(Placed {
+            centre: x,
+            grain: g,
+        });
         id
     }
 }
@@ -646,7 +665,9 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
         } else {
             params.orientations.max(1)
         };
-        (0..k).map(|_| params.shape.sample::<D>(r, &mut rng)).collect()
+        (0..k)
+            .map(|_| params.shape.sample::<D>(r, &mut rng))
+            .collect()
     };
     let mut front: BTreeSet<(u64, u32)> = BTreeSet::new();
     let first = draw(0)?.swap_remove(0);
@@ -699,7 +720,9 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
             failed_r[entry.1 as usize] = big_r;
             // Does the smallest grain of this orientation fit around P?
             let small = scaled(&ms[0], params.radius_min / big_r);
-            let keep = small.as_ref().is_some_and(|s| pk.around(entry.1, s).is_some());
+            let keep = small
+                .as_ref()
+                .is_some_and(|s| pk.around(entry.1, s).is_some());
             if !keep {
                 front.remove(&entry);
             }
@@ -741,7 +764,10 @@ fn scaled<const D: usize>(g: &Grain<D>, f: f64) -> Option<Grain<D>> {
         )),
         Geometry::Convex { vertices, .. } => {
             if D == 2 {
-                let v: Vec<Point2<f64>> = vertices.iter().map(|p| Point2::new(p[0] * f, p[1] * f)).collect();
+                let v: Vec<Point2<f64>> = vertices
+                    .iter()
+                    .map(|p| Point2::new(p[0] * f, p[1] * f))
+                    .collect();
                 Grain::<2>::polygon(&v).ok().map(|g2| recast(g2))
             } else {
                 let v: Vec<Point3<f64>> = vertices
@@ -800,7 +826,9 @@ pub fn check_pic<const D: usize>(p: &PicPacking<D>, contact_tol: f64) -> Result<
         let ri = gi.grain.circumradius;
         for (lo, hi) in parts_aabb(&shapes[i]) {
             for a in 0..D {
-                min_wall = min_wall.min(lo[a] / (2.0 * ri)).min((p.side - hi[a]) / (2.0 * ri));
+                min_wall = min_wall
+                    .min(lo[a] / (2.0 * ri))
+                    .min((p.side - hi[a]) / (2.0 * ri));
             }
         }
         for &j in &order[k + 1..] {
@@ -860,7 +888,11 @@ fn parts<const D: usize>(g: &Placed<D>) -> Vec<ParryPart> {
                     let b = parry3d_f64::math::Vector::new(s.b[0], s.b[1], s.b[2]);
                     if s.a == s.b {
                         ParryPart::D3(
-                            parry3d_f64::math::Pose::translation(c[0] + s.a[0], c[1] + s.a[1], c[2] + s.a[2]),
+                            parry3d_f64::math::Pose::translation(
+                                c[0] + s.a[0],
+                                c[1] + s.a[1],
+                                c[2] + s.a[2],
+                            ),
                             parry3d_f64::shape::SharedShape::ball(s.radius),
                         )
                     } else {
@@ -895,7 +927,10 @@ fn parts_aabb(parts: &[ParryPart]) -> Vec<([f64; 3], [f64; 3])> {
             }
             ParryPart::D3(pose, s) => {
                 let b = s.compute_aabb(pose);
-                ([b.mins.x, b.mins.y, b.mins.z], [b.maxs.x, b.maxs.y, b.maxs.z])
+                (
+                    [b.mins.x, b.mins.y, b.mins.z],
+                    [b.maxs.x, b.maxs.y, b.maxs.z],
+                )
             }
         })
         .collect()

@@ -333,7 +333,10 @@ impl Grain<3> {
         for i in 0..points.len() {
             for j in i + 1..points.len() {
                 if (points[i] - points[j]).norm() <= 1e-12 * scale {
-                    return Err(Error::RepeatedVertex { first: i, second: j });
+                    return Err(Error::RepeatedVertex {
+                        first: i,
+                        second: j,
+                    });
                 }
             }
         }
@@ -346,7 +349,12 @@ impl Grain<3> {
         if shape.points().len() != points.len() {
             let vertex = pts
                 .iter()
-                .position(|p| !shape.points().iter().any(|q| (*q - *p).length() <= 1e-12 * scale))
+                .position(|p| {
+                    !shape
+                        .points()
+                        .iter()
+                        .any(|q| (*q - *p).length() <= 1e-12 * scale)
+                })
                 .unwrap_or(0);
             return Err(Error::NotConvex { vertex });
         }
@@ -354,9 +362,21 @@ impl Grain<3> {
         let mut vol = 0.0;
         let mut inr = f64::INFINITY;
         for t in &ti {
-            let a = Vector3::new(tv[t[0] as usize].x, tv[t[0] as usize].y, tv[t[0] as usize].z);
-            let b = Vector3::new(tv[t[1] as usize].x, tv[t[1] as usize].y, tv[t[1] as usize].z);
-            let c = Vector3::new(tv[t[2] as usize].x, tv[t[2] as usize].y, tv[t[2] as usize].z);
+            let a = Vector3::new(
+                tv[t[0] as usize].x,
+                tv[t[0] as usize].y,
+                tv[t[0] as usize].z,
+            );
+            let b = Vector3::new(
+                tv[t[1] as usize].x,
+                tv[t[1] as usize].y,
+                tv[t[1] as usize].z,
+            );
+            let c = Vector3::new(
+                tv[t[2] as usize].x,
+                tv[t[2] as usize].y,
+                tv[t[2] as usize].z,
+            );
             vol += a.dot(&b.cross(&c)) / 6.0;
             let n = (b - a).cross(&(c - a));
             if n.norm() > 0.0 {
@@ -489,7 +509,9 @@ impl GrainShape {
         match *self {
             Self::Ball => Grain::ball(big_r),
             Self::Capsule { aspect } => Grain::capsule(big_r, aspect, axis),
-            Self::Cluster { aspect, spheres } => Grain::capsule_cluster(big_r, aspect, spheres, axis),
+            Self::Cluster { aspect, spheres } => {
+                Grain::capsule_cluster(big_r, aspect, spheres, axis)
+            }
             Self::Polygon {
                 sides_min,
                 sides_max,

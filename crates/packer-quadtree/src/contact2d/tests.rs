@@ -21,7 +21,11 @@ fn tangency_gives_one_solution_and_apart_gives_none() {
     // Wrappers of radius 2 at distance 4: touching, one solution.
     let s = circle_two_circles(Point2::new(0.0, 0.0), 1.0, Point2::new(4.0, 0.0), 1.0, 1.0);
     assert_eq!(s.len(), 1);
-    assert_relative_eq!(s.iter().next().unwrap_or(Point2::origin()).x, 2.0, epsilon = 1e-15);
+    assert_relative_eq!(
+        s.iter().next().unwrap_or(Point2::origin()).x,
+        2.0,
+        epsilon = 1e-15
+    );
     let s = circle_two_circles(Point2::new(0.0, 0.0), 1.0, Point2::new(4.5, 0.0), 1.0, 1.0);
     assert!(s.is_empty());
 }
@@ -29,14 +33,32 @@ fn tangency_gives_one_solution_and_apart_gives_none() {
 #[test]
 fn degenerate_inputs_give_no_solution() {
     let c = Point2::new(1.0, 2.0);
-    assert!(circle_two_circles(c, 1.0, c, 1.0, 1.0).is_empty(), "coincident");
-    assert!(circle_two_circles(c, 3.0, c + Vector2::new(0.1, 0.0), 0.5, 0.1).is_empty(), "nested");
-    assert!(circle_two_circles(c, -1.0, Point2::origin(), 1.0, 1.0).is_empty(), "negative radius");
-    assert!(circle_two_circles(c, 1.0, Point2::origin(), 1.0, f64::NAN).is_empty(), "NaN radius");
+    assert!(
+        circle_two_circles(c, 1.0, c, 1.0, 1.0).is_empty(),
+        "coincident"
+    );
+    assert!(
+        circle_two_circles(c, 3.0, c + Vector2::new(0.1, 0.0), 0.5, 0.1).is_empty(),
+        "nested"
+    );
+    assert!(
+        circle_two_circles(c, -1.0, Point2::origin(), 1.0, 1.0).is_empty(),
+        "negative radius"
+    );
+    assert!(
+        circle_two_circles(c, 1.0, Point2::origin(), 1.0, f64::NAN).is_empty(),
+        "NaN radius"
+    );
     let n = Unit::new_normalize(Vector2::new(0.0, 1.0));
     let par = intersect(
-        &Wrapper2::Line { normal: n, offset: 1.0 },
-        &Wrapper2::Line { normal: n, offset: 2.0 },
+        &Wrapper2::Line {
+            normal: n,
+            offset: 1.0,
+        },
+        &Wrapper2::Line {
+            normal: n,
+            offset: 2.0,
+        },
     );
     assert!(par.is_empty(), "parallel walls");
 }
@@ -77,7 +99,10 @@ fn circle_and_segment_wall_touch_both() {
 fn clusters_of_two_disks_touch_without_overlap() {
     let f1 = [(Point2::new(0.0, 0.0), 1.0), (Point2::new(1.0, 0.0), 1.0)];
     let f2 = [(Point2::new(4.0, 0.0), 1.0), (Point2::new(5.0, 0.0), 1.0)];
-    let m = [(Vector2::new(-0.5, 0.0), 0.8), (Vector2::new(0.5, 0.0), 0.8)];
+    let m = [
+        (Vector2::new(-0.5, 0.0), 0.8),
+        (Vector2::new(0.5, 0.0), 0.8),
+    ];
     let pts = cluster_two_clusters(&f1, &f2, &m, 1e-12);
     assert!(!pts.is_empty());
     for p in pts {
@@ -105,12 +130,19 @@ fn circle_and_square_oracle() {
         assert_relative_eq!(polygon_signed_distance(&sq, *p), 0.5, max_relative = 1e-12);
     }
     let y = (1.0f64 - 0.81).sqrt();
-    assert!(pts.iter().any(|p| (p.x - 1.5).abs() < 1e-12 && (p.y - 0.5 - y).abs() < 1e-12));
+    assert!(
+        pts.iter()
+            .any(|p| (p.x - 1.5).abs() < 1e-12 && (p.y - 0.5 - y).abs() < 1e-12)
+    );
 }
 
 #[test]
 fn bad_polygons_are_errors() {
-    let p = |v: &[(f64, f64)]| v.iter().map(|&(x, y)| Point2::new(x, y)).collect::<Vec<_>>();
+    let p = |v: &[(f64, f64)]| {
+        v.iter()
+            .map(|&(x, y)| Point2::new(x, y))
+            .collect::<Vec<_>>()
+    };
     assert!(matches!(
         convex_polygon(&p(&[(0.0, 0.0), (1.0, 0.0)])),
         Err(Error::PolygonTooFewVertices { got: 2 })
@@ -120,7 +152,13 @@ fn bad_polygons_are_errors() {
         Err(Error::RepeatedVertex { .. })
     ));
     assert!(matches!(
-        convex_polygon(&p(&[(0.0, 0.0), (2.0, 0.0), (1.0, 0.3), (2.0, 2.0), (0.0, 2.0)])),
+        convex_polygon(&p(&[
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (1.0, 0.3),
+            (2.0, 2.0),
+            (0.0, 2.0)
+        ])),
         Err(Error::NotConvex { .. })
     ));
     assert!(matches!(

@@ -67,7 +67,10 @@ fn corner_and_floor_oracles() {
     // Two unit spheres on the floor at (±1, 0, 1), unit mobile on the floor:
     // centres at (0, ±√3, 1).
     let s = sphere_spheres_planes(
-        &[(Point3::new(-1.0, 0.0, 1.0), 1.0), (Point3::new(1.0, 0.0, 1.0), 1.0)],
+        &[
+            (Point3::new(-1.0, 0.0, 1.0), 1.0),
+            (Point3::new(1.0, 0.0, 1.0), 1.0),
+        ],
         &[(Point3::origin(), Vector3::z_axis())],
         1.0,
     );
@@ -80,9 +83,17 @@ fn corner_and_floor_oracles() {
 
 #[test]
 fn sphere_clusters_touch_all_three() {
-    let pair = |x: f64, y: f64| [(Point3::new(x, y, 0.0), 1.0), (Point3::new(x + 1.0, y, 0.0), 1.0)];
+    let pair = |x: f64, y: f64| {
+        [
+            (Point3::new(x, y, 0.0), 1.0),
+            (Point3::new(x + 1.0, y, 0.0), 1.0),
+        ]
+    };
     let (a, b, c) = (pair(0.0, 0.0), pair(3.0, 0.0), pair(1.5, 2.8));
-    let m = [(Vector3::new(0.0, 0.0, -0.4), 0.9), (Vector3::new(0.0, 0.0, 0.4), 0.9)];
+    let m = [
+        (Vector3::new(0.0, 0.0, -0.4), 0.9),
+        (Vector3::new(0.0, 0.0, 0.4), 0.9),
+    ];
     let pts = cluster_three_clusters([&a, &b, &c], &m, 1e-12);
     assert!(!pts.is_empty());
     for p in pts {
