@@ -120,6 +120,84 @@ impl PicParams {
     }
 }
 
+impl PicParams {
+    /// The configuration we use for a row of Pérez Morales et al. 2016
+    /// (`fixtures/reference/perezmorales2016_packings.csv`), with its
+    /// dimension: side 20 (2D) or 40 (3D), `R ~ U[1, 2]`, aspect ratio
+    /// `r/R = 0.5` (see [`crate::GrainShape`]). Our choices where the seed
+    /// is silent: P1 half disks, half regular 4–8-gons, Newton on parry
+    /// contacts; P2 4-disk clusters by the seed's wrappers, 8 orientations
+    /// tried per grain; P3 exact capsules by Newton, 64 orientations; P4
+    /// exact capsules by Newton, the drawn orientation only, 10 partners;
+    /// P5 4-sphere clusters by Newton, 10 partners.
+    ///
+    /// # Errors
+    /// [`Error::Parameter`] for an unknown row id.
+    pub fn perezmorales2016(row: &str) -> Result<(usize, Self)> {
+        let base = Self::default();
+        let capsule = GrainShape::Capsule { aspect: 0.5 };
+        let cluster = GrainShape::Cluster {
+            aspect: 0.5,
+            spheres: 4,
+        };
+        Ok(match row {
+            "P1" => (
+                2,
+                Self {
+                    shape: GrainShape::Mix {
+                        polygon_share: 0.5,
+                        sides_min: 4,
+                        sides_max: 8,
+                    },
+                    ..base
+                },
+            ),
+            "P2" => (
+                2,
+                Self {
+                    shape: cluster,
+                    method: ContactMethod::Wrappers,
+                    orientations: 8,
+                    ..base
+                },
+            ),
+            "P3" => (
+                2,
+                Self {
+                    shape: capsule,
+                    orientations: 64,
+                    ..base
+                },
+            ),
+            "P4" => (
+                3,
+                Self {
+                    side: 40.0,
+                    shape: capsule,
+                    neighbours: 10,
+                    ..base
+                },
+            ),
+            "P5" => (
+                3,
+                Self {
+                    side: 40.0,
+                    shape: cluster,
+                    neighbours: 10,
+                    ..base
+                },
+            ),
+            _ => {
+                return Err(Error::Parameter {
+                    what: "perezmorales2016 row (P1..P5)",
+                    value: f64::NAN,
+                    range: "P1, P2, P3, P4, P5",
+                });
+            }
+        })
+    }
+}
+
 /// A placed grain.
 #[derive(Debug, Clone)]
 pub struct Placed<const D: usize> {

@@ -7,6 +7,7 @@ mod cloner;
 mod fixture_integrity;
 mod levelset;
 mod packer_quadtree;
+mod perez_morales;
 mod rounding;
 mod sph_harmonics;
 
@@ -18,6 +19,7 @@ pub fn registry() -> Vec<Case> {
     cases.extend(fixture_integrity::cases());
     cases.extend(levelset::cases());
     cases.extend(packer_quadtree::cases());
+    cases.extend(perez_morales::cases());
     cases.extend(sph_harmonics::cases());
     cases
 }
@@ -30,6 +32,7 @@ pub fn expected_failures() -> Vec<ExpectedFailure> {
     list.extend_from_slice(fixture_integrity::EXPECTED_FAILURES);
     list.extend_from_slice(levelset::EXPECTED_FAILURES);
     list.extend_from_slice(packer_quadtree::EXPECTED_FAILURES);
+    list.extend_from_slice(perez_morales::EXPECTED_FAILURES);
     list.extend_from_slice(sph_harmonics::EXPECTED_FAILURES);
     list
 }
