@@ -194,3 +194,24 @@ proptest! {
         prop_assert!(w >= -1e-9, "wall {w}");
     }
 }
+
+#[test]
+fn vtu_for_every_shape() {
+    for shape in [
+        GrainShape::Ball,
+        GrainShape::Capsule { aspect: 0.5 },
+        GrainShape::Polygon {
+            sides_min: 4,
+            sides_max: 5,
+        },
+    ] {
+        let p = pack_pic::<2>(&small(shape, 6.0), 1).expect("pack");
+        let mut out = Vec::new();
+        write_pic_vtu(&p, &mut out).expect("vtu 2D");
+        assert!(String::from_utf8_lossy(&out).contains("</VTKFile>"));
+        let p = pack_pic::<3>(&small(shape, 5.0), 1).expect("pack");
+        let mut out = Vec::new();
+        write_pic_vtu(&p, &mut out).expect("vtu 3D");
+        assert!(String::from_utf8_lossy(&out).contains("<Piece NumberOfPoints"));
+    }
+}
