@@ -28,7 +28,14 @@
 //! * [`optimise_porosity`]: genetic porosity control (§4.1–4.2);
 //!   [`graded_layers`]: functionally graded property layers (§4.3);
 //! * writers: [`write_csv`], [`write_vtu`], [`write_lammps_data`],
-
+//!   [`write_yade`], [`write_svg`];
+//! * particle in contact (Pérez Morales et al. 2016): closed-form wrappers
+//!   [`contact2d`] and [`contact3d`], gap functions with Newton and
+//!   Nelder–Mead [`gap`], grain shapes ([`Grain`], [`GrainShape`]:
+//!   disks/spheres, spherocylinders, clusters, convex polygons/polyhedra),
+//!   packings [`pack_pic`] in a square or cube ([`PicParams`],
+//!   [`ContactMethod`], presets [`PicParams::perezmorales2016`]), the
+//!   independent parry checker [`check_pic`] and [`write_pic_vtu`].
 //!
 //! ```
 //! use packer_quadtree::{pack, check_packing, porosity, Domain, Grading, PackParams};
