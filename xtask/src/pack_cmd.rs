@@ -160,7 +160,9 @@ pub(crate) fn parse_shape(
                 }
             }
         }
-        _ => bail!("unknown shape `{kind}` (disk, sphere, ball, capsule, cluster, polygon, mix, row)"),
+        _ => bail!(
+            "unknown shape `{kind}` (disk, sphere, ball, capsule, cluster, polygon, mix, row)"
+        ),
     };
     let dim = if kind == "sphere" { 3 } else { dim };
     if dim != 2 && dim != 3 {
@@ -429,8 +431,14 @@ mod tests {
         ] {
             assert!(parse_shape(sh, 2, 20.0, "1,2", 1).is_err(), "{sh}");
         }
-        assert!(parse_shape("capsule:0.5", 2, 3.0, "1,2", 1).is_err(), "domain too small");
-        assert!(parse_shape("ball", 2, 20.0, "0,2", 1).is_err(), "zero radius");
+        assert!(
+            parse_shape("capsule:0.5", 2, 3.0, "1,2", 1).is_err(),
+            "domain too small"
+        );
+        assert!(
+            parse_shape("ball", 2, 20.0, "0,2", 1).is_err(),
+            "zero radius"
+        );
         assert!(parse_shape("capsule:0.5", 2, 20.0, "1,2", 1).is_ok());
         assert!(parse_shape("row:P4", 2, 20.0, "1,2", 1).is_ok_and(|(d, _)| d == 3));
         for g in [

@@ -22,7 +22,7 @@
 //! The segment–segment distance of the hot loop is written by hand
 //! (Ericson 2005, §5.1.9) in nalgebra for any dimension: parry's version
 //! works on glam vectors of one dimension per crate, and the packer's inner
-//! loop is generic over `D`. The independent checker ([`crate::pic`]) uses
+//! loop is generic over `D`. The independent checker ([`crate::check_pic`]) uses
 //! parry's own distances, so the two never share arithmetic.
 
 use nalgebra::{SMatrix, SVector};

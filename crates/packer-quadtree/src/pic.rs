@@ -1084,9 +1084,10 @@ pub fn write_pic_vtu<const D: usize>(p: &PicPacking<D>, mut w: impl std::io::Wri
                 ParryConvex::Polyhedron(poly) => {
                     let (tv, ti) = poly.to_trimesh();
                     let a = points.len();
-                    points.extend(tv.iter().map(|v| {
-                        [g.centre[0] + v.x, g.centre[1] + v.y, g.centre[2 % D] + v.z]
-                    }));
+                    points
+                        .extend(tv.iter().map(|v| {
+                            [g.centre[0] + v.x, g.centre[1] + v.y, g.centre[2 % D] + v.z]
+                        }));
                     for t in ti {
                         cells.push((t.iter().map(|&k| a + k as usize).collect(), 5, gi, 0.0));
                     }
@@ -1112,7 +1113,10 @@ pub fn write_pic_vtu<const D: usize>(p: &PicPacking<D>, mut w: impl std::io::Wri
         writeln!(w, "{}", c.2)?;
     }
     writeln!(w, "</DataArray>")?;
-    writeln!(w, r#"<DataArray type="Float64" Name="radius" format="ascii">"#)?;
+    writeln!(
+        w,
+        r#"<DataArray type="Float64" Name="radius" format="ascii">"#
+    )?;
     for c in &cells {
         writeln!(w, "{:e}", c.3)?;
     }
@@ -1134,7 +1138,10 @@ pub fn write_pic_vtu<const D: usize>(p: &PicPacking<D>, mut w: impl std::io::Wri
         writeln!(w, "{}", s.join(" "))?;
     }
     writeln!(w, "</DataArray>")?;
-    writeln!(w, r#"<DataArray type="Int64" Name="offsets" format="ascii">"#)?;
+    writeln!(
+        w,
+        r#"<DataArray type="Int64" Name="offsets" format="ascii">"#
+    )?;
     let mut off = 0;
     for c in &cells {
         off += c.0.len();
@@ -1145,6 +1152,9 @@ pub fn write_pic_vtu<const D: usize>(p: &PicPacking<D>, mut w: impl std::io::Wri
     for c in &cells {
         writeln!(w, "{}", c.1)?;
     }
-    writeln!(w, "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>")?;
+    writeln!(
+        w,
+        "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>"
+    )?;
     Ok(())
 }
