@@ -117,7 +117,7 @@ pub fn intersect(a: &Wrapper2, b: &Wrapper2) -> Solutions<Point2<f64>> {
         }
         (Circle { centre, radius }, Line { normal, offset })
         | (Line { normal, offset }, Circle { centre, radius }) => {
-            if !(radius > 0.0) {
+            if !radius.gt(&0.0) {
                 return Solutions::none();
             }
             // Linear equation relative to the centre: n·y = offset − n·c.
@@ -134,7 +134,7 @@ pub fn intersect(a: &Wrapper2, b: &Wrapper2) -> Solutions<Point2<f64>> {
                 radius: r2,
             },
         ) => {
-            if !(r1 > 0.0 && r2 > 0.0) {
+            if !(r1.gt(&0.0) && r2.gt(&0.0)) {
                 return Solutions::none();
             }
             let a = c2 - c1;
@@ -154,7 +154,7 @@ pub fn intersect(a: &Wrapper2, b: &Wrapper2) -> Solutions<Point2<f64>> {
 /// Points `c + y` with `a·y = b` and `|y| = rho` (`a ≠ 0`).
 fn solve_line_circle(c: Point2<f64>, rho: f64, a: Vector2<f64>, b: f64) -> Solutions<Point2<f64>> {
     let aa = a.norm_squared();
-    if !(aa > 0.0) || !aa.is_finite() || !b.is_finite() {
+    if !aa.gt(&0.0) || !aa.is_finite() || !b.is_finite() {
         return Solutions::none();
     }
     let y0 = a * (b / aa);
@@ -184,7 +184,7 @@ pub fn circle_two_circles(
     r2: f64,
     r: f64,
 ) -> Solutions<Point2<f64>> {
-    if !(r1 > 0.0 && r2 > 0.0 && r > 0.0) {
+    if !(r1.gt(&0.0) && r2.gt(&0.0) && r.gt(&0.0)) {
         return Solutions::none();
     }
     intersect(
@@ -210,7 +210,7 @@ pub fn circle_circle_line(
     n: Unit<Vector2<f64>>,
     r: f64,
 ) -> Solutions<Point2<f64>> {
-    if !(r1 > 0.0 && r > 0.0) {
+    if !(r1.gt(&0.0) && r.gt(&0.0)) {
         return Solutions::none();
     }
     intersect(
@@ -238,7 +238,7 @@ pub fn circle_circle_segment(
     r: f64,
 ) -> Vec<Point2<f64>> {
     let mut out = Vec::new();
-    if !(r1 > 0.0 && r > 0.0) {
+    if !(r1.gt(&0.0) && r.gt(&0.0)) {
         return out;
     }
     let ab = b - a;
@@ -457,7 +457,7 @@ pub fn circle_circle_polygon(
     r: f64,
 ) -> Vec<Point2<f64>> {
     let mut out: Vec<Point2<f64>> = Vec::new();
-    if !(r1 > 0.0 && r > 0.0) || poly.len() < 3 {
+    if !(r1.gt(&0.0) && r.gt(&0.0)) || poly.len() < 3 {
         return out;
     }
     let n = poly.len();

@@ -48,7 +48,7 @@ pub fn intersect(w: &[Wrapper3; 3]) -> Solutions<Point3<f64>> {
     for x in w {
         match *x {
             Wrapper3::Sphere { centre, radius } => {
-                if !(radius > 0.0) || !radius.is_finite() {
+                if !radius.gt(&0.0) || !radius.is_finite() {
                     return Solutions::none();
                 }
                 sph[ns] = (centre, radius);
@@ -100,7 +100,7 @@ pub fn intersect(w: &[Wrapper3; 3]) -> Solutions<Point3<f64>> {
     let (a2, b2) = lin[1];
     let u = a1.cross(&a2);
     let uu = u.norm_squared();
-    if !(uu > (1e-12 * a1.norm() * a2.norm()).powi(2)) || !uu.is_finite() {
+    if !uu.gt(&(1e-12 * a1.norm() * a2.norm()).powi(2)) || !uu.is_finite() {
         return Solutions::none();
     }
     let y0 = (a2.cross(&u) * b1 + u.cross(&a1) * b2) / uu;
@@ -120,7 +120,7 @@ pub fn intersect(w: &[Wrapper3; 3]) -> Solutions<Point3<f64>> {
 /// from outside. Collinear or coincident centres give none.
 #[must_use]
 pub fn sphere_three_spheres(fixed: &[(Point3<f64>, f64); 3], r: f64) -> Solutions<Point3<f64>> {
-    if !(r > 0.0) || fixed.iter().any(|f| !(f.1 > 0.0)) {
+    if !r.gt(&0.0) || fixed.iter().any(|f| !f.1.gt(&0.0)) {
         return Solutions::none();
     }
     intersect(&fixed.map(|(c, rf)| Wrapper3::Sphere {
@@ -138,7 +138,7 @@ pub fn sphere_spheres_planes(
     planes: &[(Point3<f64>, Unit<Vector3<f64>>)],
     r: f64,
 ) -> Solutions<Point3<f64>> {
-    if spheres.len() + planes.len() != 3 || !(r > 0.0) || spheres.iter().any(|s| !(s.1 > 0.0)) {
+    if spheres.len() + planes.len() != 3 || !r.gt(&0.0) || spheres.iter().any(|s| !s.1.gt(&0.0)) {
         return Solutions::none();
     }
     let mut w = [Wrapper3::Plane {

@@ -332,7 +332,7 @@ fn solve_small<const D: usize>(
     mut b: SVector<f64, D>,
 ) -> Option<SVector<f64, D>> {
     let scale = a.amax();
-    if !(scale > 0.0) || !scale.is_finite() {
+    if !scale.gt(&0.0) || !scale.is_finite() {
         return None;
     }
     for k in 0..D {

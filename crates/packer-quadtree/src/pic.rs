@@ -641,11 +641,12 @@ impl<const D: usize> Packer<'_, D> {
             } else {
                 self.refine(&set[..D], m, &g)
             };
-            if let Some(x) = x {
-                if x[last] < best_h && self.feasible(m, &x) {
-                    best_h = x[last];
-                    best = Some(x);
-                }
+            if let Some(x) = x
+                && x[last] < best_h
+                && self.feasible(m, &x)
+            {
+                best_h = x[last];
+                best = Some(x);
             }
         }
         best
@@ -786,10 +787,10 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
             }
             tries += 1;
             for (k, m) in ms.iter().enumerate() {
-                if let Some(x) = pk.around(entry.1, m) {
-                    if placed.is_none_or(|(b, _)| x[D - 1] < b[D - 1]) {
-                        placed = Some((x, k));
-                    }
+                if let Some(x) = pk.around(entry.1, m)
+                    && placed.is_none_or(|(b, _)| x[D - 1] < b[D - 1])
+                {
+                    placed = Some((x, k));
                 }
             }
             if placed.is_some() {
@@ -846,13 +847,13 @@ fn scaled<const D: usize>(g: &Grain<D>, f: f64) -> Option<Grain<D>> {
                     .iter()
                     .map(|p| Point2::new(p[0] * f, p[1] * f))
                     .collect();
-                Grain::<2>::polygon(&v).ok().map(|g2| recast(g2))
+                Grain::<2>::polygon(&v).ok().map(recast)
             } else {
                 let v: Vec<Point3<f64>> = vertices
                     .iter()
                     .map(|p| Point3::new(p[0] * f, p[1] * f, p[2] * f))
                     .collect();
-                Grain::<3>::polyhedron(&v).ok().map(|g3| recast(g3))
+                Grain::<3>::polyhedron(&v).ok().map(recast)
             }
         }
     }
@@ -889,7 +890,7 @@ pub fn check_pic<const D: usize>(p: &PicPacking<D>, contact_tol: f64) -> Result<
     if p.grains.is_empty() {
         return Err(Error::Empty { what: "packing" });
     }
-    let shapes: Vec<Vec<ParryPart>> = p.grains.iter().map(|g| parts(g)).collect();
+    let shapes: Vec<Vec<ParryPart>> = p.grains.iter().map(parts).collect();
     let mut order: Vec<usize> = (0..p.grains.len()).collect();
     order.sort_by(|&a, &b| {
         let ka = p.grains[a].centre[0] - p.grains[a].grain.circumradius;

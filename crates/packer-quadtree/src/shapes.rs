@@ -383,7 +383,7 @@ impl Grain<3> {
                 inr = inr.min((a.dot(&n) / n.norm()).abs());
             }
         }
-        if !(vol.abs() > 1e-12 * scale.powi(3)) {
+        if !vol.abs().gt(&(1e-12 * scale.powi(3))) {
             return Err(Error::DegeneratePolygon);
         }
         let verts: Vec<SVector<f64, 3>> = points.iter().map(|p| p.coords).collect();
