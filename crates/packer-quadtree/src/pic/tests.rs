@@ -171,7 +171,7 @@ proptest! {
             1 => GrainShape::Capsule { aspect },
             2 => GrainShape::Cluster { aspect, spheres: 3 },
             3 => GrainShape::Polygon { sides_min: 4, sides_max: 6 },
-            _ => GrainShape::Mix { polygon_share: 0.3, sides_min: 3, sides_max: 5 },
+            _ => GrainShape::Mix { polygon_share: 0.3, sides_min: 4, sides_max: 5 },
         };
         let params = PicParams {
             side,
