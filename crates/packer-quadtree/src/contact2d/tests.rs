@@ -1,3 +1,5 @@
+//! Oracles (analytic tangent configurations) and property tests of the 2D wrappers.
+
 use super::*;
 use approx::assert_relative_eq;
 use proptest::prelude::*;

@@ -1,3 +1,5 @@
+//! Oracles (tetrahedron, corner, floor) and property tests of the 3D wrappers.
+
 use super::*;
 use approx::assert_relative_eq;
 use proptest::prelude::*;

@@ -1,3 +1,5 @@
+//! Gap oracles and the convergence of Newton and Nelder–Mead from 100 random starts.
+
 use super::*;
 use crate::shapes::Grain;
 use approx::assert_relative_eq;

@@ -1,3 +1,5 @@
+//! Golden digests, overlap-free packings of every shape (parry checker), bad input, VTU.
+
 use super::*;
 use proptest::prelude::*;
 
