@@ -1,148 +1,49 @@
-//! Packs the rows of Pérez Morales et al. 2016 and prints fraction, speed
-//! and the independent checker's worst gap (`cargo run --release --example
-//! pic_rows -- P4`).
-#![allow(clippy::print_stdout, clippy::unwrap_used)]
+//! A timing report of the Pérez Morales et al. 2016 rows with our presets
+//! (`PicParams::perezmorales2016`): grains, seconds, grains/s, fraction and
+//! the independent checker's worst gap. `cargo run --release --example
+//! pic_rows -- P4 P5` (no argument: every row; `SEED=2` another seed).
+#![allow(clippy::print_stdout)]
 
-use packer_quadtree::{ContactMethod, GrainShape, PicParams, check_pic, pack_pic};
+use packer_quadtree::{PicParams, check_pic, pack_pic};
 use std::time::Instant;
 
 fn main() {
     let which: Vec<String> = std::env::args().skip(1).collect();
-    let want = |s: &str| which.is_empty() || which.iter().any(|w| w == s);
-    let base = PicParams::default();
-    let rows: Vec<(&str, usize, PicParams)> = vec![
-        (
-            "P1",
-            2,
-            PicParams {
-                shape: GrainShape::Mix {
-                    polygon_share: 0.5,
-                    sides_min: 4,
-                    sides_max: 8,
-                },
-                ..base.clone()
-            },
-        ),
-        (
-            "P2",
-            2,
-            PicParams {
-                shape: GrainShape::Cluster {
-                    aspect: 0.5,
-                    spheres: 4,
-                },
-                method: ContactMethod::Wrappers,
-                ..base.clone()
-            },
-        ),
-        ("P3", 2, PicParams { ..base.clone() }),
-        (
-            "P3o",
-            2,
-            PicParams {
-                orientations: 8,
-                ..base.clone()
-            },
-        ),
-        (
-            "P2o",
-            2,
-            PicParams {
-                orientations: 8,
-                shape: GrainShape::Cluster {
-                    aspect: 0.5,
-                    spheres: 4,
-                },
-                method: ContactMethod::Wrappers,
-                ..base.clone()
-            },
-        ),
-        (
-            "P4o",
-            3,
-            PicParams {
-                orientations: 4,
-                side: 40.0,
-                ..base.clone()
-            },
-        ),
-        (
-            "P3nm",
-            2,
-            PicParams {
-                method: ContactMethod::NelderMead,
-                ..base.clone()
-            },
-        ),
-        (
-            "P4",
-            3,
-            PicParams {
-                side: 40.0,
-                ..base.clone()
-            },
-        ),
-        (
-            "P5",
-            3,
-            PicParams {
-                side: 40.0,
-                shape: GrainShape::Cluster {
-                    aspect: 0.5,
-                    spheres: 4,
-                },
-                ..base.clone()
-            },
-        ),
-        (
-            "S3",
-            3,
-            PicParams {
-                side: 40.0,
-                shape: GrainShape::Ball,
-                ..base.clone()
-            },
-        ),
-    ];
-    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<usize>().ok());
-    for (name, dim, mut p) in rows {
-        if !want(name) {
+    let seed = std::env::var("SEED")
+        .ok()
+        .and_then(|v| v.parse::<u64>().ok())
+        .unwrap_or(1);
+    for id in ["P1", "P2", "P3", "P4", "P5"] {
+        if !which.is_empty() && !which.iter().any(|w| w == id) {
             continue;
         }
-        if let Some(o) = env("ORI") {
-            p.orientations = o;
-        }
-        if let Some(o) = env("NB") {
-            p.neighbours = o;
-        }
-        let seed = env("SEED").unwrap_or(1) as u64;
-        let t = Instant::now();
-        let (n, frac, rej, rep) = if dim == 2 {
-            let k = pack_pic::<2>(&p, seed).unwrap();
-            let dt = t.elapsed();
-            let rep = check_pic(&k, 1e-9).unwrap();
-            println!(
-                "{name}: {} grains in {:.3} s = {:.1} p/s",
-                k.grains.len(),
-                dt.as_secs_f64(),
-                k.grains.len() as f64 / dt.as_secs_f64()
-            );
-            (k.grains.len(), k.fraction(), k.rejected, rep)
-        } else {
-            let k = pack_pic::<3>(&p, seed).unwrap();
-            let dt = t.elapsed();
-            let rep = check_pic(&k, 1e-9).unwrap();
-            println!(
-                "{name}: {} grains in {:.3} s = {:.1} p/s",
-                k.grains.len(),
-                dt.as_secs_f64(),
-                k.grains.len() as f64 / dt.as_secs_f64()
-            );
-            (k.grains.len(), k.fraction(), k.rejected, rep)
+        let Ok((dim, p)) = PicParams::perezmorales2016(id) else {
+            continue;
         };
-        println!(
-            "   n {n} fraction {frac:.4} rejected {rej} min gap/d {:.3e} wall {:.3e} Z {:.2}",
-            rep.min_relative_gap, rep.min_relative_wall_gap, rep.coordination
-        );
+        let t = Instant::now();
+        let row = if dim == 2 {
+            pack_pic::<2>(&p, seed).and_then(|k| {
+                let s = t.elapsed().as_secs_f64();
+                let r = check_pic(&k, 1e-9)?;
+                Ok((k.grains.len(), s, k.fraction(), r))
+            })
+        } else {
+            pack_pic::<3>(&p, seed).and_then(|k| {
+                let s = t.elapsed().as_secs_f64();
+                let r = check_pic(&k, 1e-9)?;
+                Ok((k.grains.len(), s, k.fraction(), r))
+            })
+        };
+        match row {
+            Ok((n, s, f, r)) => println!(
+                "{id}: {n} grains in {s:.3} s = {:.1} grains/s, fraction {f:.4}, coordination {:.2}, \
+                 worst gap/d {:.2e} (walls {:.2e})",
+                n as f64 / s,
+                r.coordination,
+                r.min_relative_gap,
+                r.min_relative_wall_gap
+            ),
+            Err(e) => println!("{id}: error {e}"),
+        }
     }
 }
