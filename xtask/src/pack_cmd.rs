@@ -14,8 +14,9 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use nalgebra::Point2;
 use packer_quadtree::{
-    Domain, Grading, PackParams, check_packing, pack_seeded, porosity, write_csv,
-    write_lammps_data, write_svg, write_vtu, write_yade,
+    Domain, Grading, GrainShape, PackParams, PicPacking, PicParams, check_packing, check_pic,
+    pack_pic, pack_seeded, porosity, write_csv, write_lammps_data, write_pic_vtu, write_svg,
+    write_vtu, write_yade,
 };
 
 /// Parameter presets of the packer.
@@ -77,6 +78,136 @@ pub(crate) struct Pack {
     /// Output directory.
     #[arg(long, default_value = "target/packing")]
     out: PathBuf,
+    /// Grain shape: `disk` (the Pinto 2009 packer above), or one of the
+    /// particle-in-contact packer (Pérez Morales 2016) in the square/cube
+    /// `[0, --side]^D`: `sphere` (3D), `ball`, `capsule:ASPECT`,
+    /// `cluster:ASPECT[,N]` (N disks/spheres, default 4),
+    /// `polygon:MIN[,MAX]` (sides; hull vertices in 3D),
+    /// `mix:SHARE[,MIN,MAX]` (disks and polygons), or `row:P1`…`row:P5`
+    /// (the seed's rows). ASPECT is width/length = r/R in (0, 1].
+    /// These write `packing.vtu` only.
+    #[arg(long, default_value = "disk")]
+    shape: String,
+    /// Dimension of the particle-in-contact packer (2 or 3).
+    #[arg(long, default_value_t = 2)]
+    dim: usize,
+    /// Side of the square/cube of the particle-in-contact packer.
+    #[arg(long, default_value_t = 20.0)]
+    side: f64,
+    /// Circumscribed radii `MIN,MAX` (uniform) of the particle-in-contact packer.
+    #[arg(long, default_value = "1,2")]
+    radii: String,
+    /// Orientations tried per grain (1 = the drawn random orientation).
+    #[arg(long, default_value_t = 1)]
+    orientations: usize,
+}
+
+/// Parses `--shape` (other than `disk`) into a dimension and parameters.
+pub(crate) fn parse_shape(
+    s: &str,
+    dim: usize,
+    side: f64,
+    radii: &str,
+    orientations: usize,
+) -> anyhow::Result<(usize, PicParams)> {
+    let (kind, rest) = s.split_once(':').unwrap_or((s, ""));
+    if kind == "row" {
+        return Ok(PicParams::perezmorales2016(rest)?);
+    }
+    let [radius_min, radius_max] = exactly(numbers(radii, "radii")?, "--radii")?;
+    let nums = |what: &str| numbers(rest, what);
+    let shape = match kind {
+        "sphere" | "ball" => GrainShape::Ball,
+        "capsule" => {
+            let [aspect] = exactly(nums("capsule")?, "capsule")?;
+            GrainShape::Capsule { aspect }
+        }
+        "cluster" => {
+            let v = nums("cluster")?;
+            let aspect = *v.first().context("cluster needs ASPECT")?;
+            let spheres = v.get(1).copied().unwrap_or(4.0);
+            if spheres.fract() != 0.0 || spheres < 0.0 {
+                bail!("cluster: N must be a whole number, got {spheres}");
+            }
+            GrainShape::Cluster {
+                aspect,
+                spheres: spheres as usize,
+            }
+        }
+        "polygon" | "mix" => {
+            let v = nums(kind)?;
+            let whole = |x: f64| -> anyhow::Result<usize> {
+                if x.fract() != 0.0 || x < 0.0 {
+                    bail!("{kind}: side counts must be whole numbers, got {x}");
+                }
+                Ok(x as usize)
+            };
+            if kind == "polygon" {
+                let lo = whole(*v.first().context("polygon needs MIN")?)?;
+                let hi = whole(v.get(1).copied().unwrap_or(lo as f64))?;
+                GrainShape::Polygon {
+                    sides_min: lo,
+                    sides_max: hi,
+                }
+            } else {
+                let share = *v.first().context("mix needs SHARE")?;
+                let lo = whole(v.get(1).copied().unwrap_or(4.0))?;
+                let hi = whole(v.get(2).copied().unwrap_or(8.0))?;
+                GrainShape::Mix {
+                    polygon_share: share,
+                    sides_min: lo,
+                    sides_max: hi,
+                }
+            }
+        }
+        _ => bail!(
+            "unknown shape `{kind}` (disk, sphere, ball, capsule, cluster, polygon, mix, row)"
+        ),
+    };
+    let dim = if kind == "sphere" { 3 } else { dim };
+    if dim != 2 && dim != 3 {
+        bail!("--dim must be 2 or 3, got {dim}");
+    }
+    let params = PicParams {
+        side,
+        radius_min,
+        radius_max,
+        shape,
+        orientations,
+        ..PicParams::default()
+    };
+    params.validate(dim)?;
+    Ok((dim, params))
+}
+
+fn write_pic<const D: usize>(p: &PicPacking<D>, dir: &Path, secs: f64) -> anyhow::Result<()> {
+    let rep = check_pic(p, 1e-9)?;
+    if rep.min_relative_gap < -1e-9 || rep.min_relative_wall_gap < -1e-9 {
+        bail!(
+            "the independent checker rejects this packing (min gap / d {:.2e}, wall {:.2e}): \
+             nothing written; please report it with the command line",
+            rep.min_relative_gap,
+            rep.min_relative_wall_gap
+        );
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let path = dir.join("packing.vtu");
+    let w = BufWriter::new(
+        std::fs::File::create(&path).with_context(|| format!("creating {}", path.display()))?,
+    );
+    write_pic_vtu(p, w).with_context(|| format!("writing {}", path.display()))?;
+    println!(
+        "{} grains ({} discarded) in {secs:.2} s = {:.0} grains/s: fraction {:.4}, coordination \
+         number {:.2}, min gap / d {:.2e}; written to {}",
+        p.grains.len(),
+        p.rejected,
+        p.grains.len() as f64 / secs.max(1e-9),
+        p.fraction(),
+        rep.coordination,
+        rep.min_relative_gap,
+        path.display()
+    );
+    Ok(())
 }
 
 fn numbers(s: &str, what: &str) -> anyhow::Result<Vec<f64>> {
@@ -172,6 +303,24 @@ pub(crate) fn parse_grading(s: &str) -> anyhow::Result<Grading> {
 
 impl Pack {
     pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
+        if self.shape != "disk" {
+            let (dim, params) = parse_shape(
+                &self.shape,
+                self.dim,
+                self.side,
+                &self.radii,
+                self.orientations,
+            )?;
+            let dir = root.join(&self.out);
+            let start = Instant::now();
+            return if dim == 2 {
+                let p = pack_pic::<2>(&params, self.seed)?;
+                write_pic(&p, &dir, start.elapsed().as_secs_f64())
+            } else {
+                let p = pack_pic::<3>(&params, self.seed)?;
+                write_pic(&p, &dir, start.elapsed().as_secs_f64())
+            };
+        }
         let domain = parse_domain(&self.domain)?;
         let grading = parse_grading(&self.grading)?;
         let params = match self.preset {
@@ -240,7 +389,7 @@ impl Pack {
 
 #[cfg(test)]
 mod tests {
-    use super::{parse_domain, parse_grading};
+    use super::{parse_domain, parse_grading, parse_shape};
     use packer_quadtree::{Domain, Grading};
 
     #[test]
@@ -270,6 +419,28 @@ mod tests {
         for d in ["rect:1", "rect:a,b", "hexagon:3", "polygon:0,0;1"] {
             assert!(parse_domain(d).is_err(), "{d}");
         }
+        for sh in [
+            "capsule:1.5",
+            "capsule:0",
+            "cluster:0.5,1",
+            "polygon:2",
+            "polygon:3.5",
+            "mix:2",
+            "row:P9",
+            "cone:1",
+        ] {
+            assert!(parse_shape(sh, 2, 20.0, "1,2", 1).is_err(), "{sh}");
+        }
+        assert!(
+            parse_shape("capsule:0.5", 2, 3.0, "1,2", 1).is_err(),
+            "domain too small"
+        );
+        assert!(
+            parse_shape("ball", 2, 20.0, "0,2", 1).is_err(),
+            "zero radius"
+        );
+        assert!(parse_shape("capsule:0.5", 2, 20.0, "1,2", 1).is_ok());
+        assert!(parse_shape("row:P4", 2, 20.0, "1,2", 1).is_ok_and(|(d, _)| d == 3));
         for g in [
             "uniform:2",
             "sieve:1.3:0,1.2:100",

@@ -84,6 +84,20 @@ pub enum Error {
         /// Index of the second edge.
         second: usize,
     },
+    /// Two vertices of a polygon or polyhedron coincide.
+    #[error("vertices {first} and {second} coincide")]
+    RepeatedVertex {
+        /// Index of the first vertex.
+        first: usize,
+        /// Index of the second vertex.
+        second: usize,
+    },
+    /// A polygon or polyhedron that must be convex is not.
+    #[error("shape is not convex at vertex {vertex}")]
+    NotConvex {
+        /// Index of the first offending vertex.
+        vertex: usize,
+    },
     /// A polygon with zero area.
     #[error("polygon has zero area")]
     DegeneratePolygon,

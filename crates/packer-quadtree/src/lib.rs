@@ -1,4 +1,5 @@
-//! Advancing-front dense packing of disks (Pinto 2009).
+//! Advancing-front dense packing of disks (Pinto 2009) and of general
+//! grains by particle-in-contact solvers (Pérez Morales et al. 2016).
 //!
 //! Purpose: fill a 2D domain with non-overlapping disks that follow a
 //! prescribed grading, fast, and write them for DEM codes.
@@ -27,7 +28,14 @@
 //! * [`optimise_porosity`]: genetic porosity control (§4.1–4.2);
 //!   [`graded_layers`]: functionally graded property layers (§4.3);
 //! * writers: [`write_csv`], [`write_vtu`], [`write_lammps_data`],
-//!   [`write_yade`], [`write_svg`].
+//!   [`write_yade`], [`write_svg`];
+//! * particle in contact (Pérez Morales et al. 2016): closed-form wrappers
+//!   [`contact2d`] and [`contact3d`], gap functions with Newton and
+//!   Nelder–Mead [`gap`], grain shapes ([`Grain`], [`GrainShape`]:
+//!   disks/spheres, spherocylinders, clusters, convex polygons/polyhedra),
+//!   packings [`pack_pic`] in a square or cube ([`PicParams`],
+//!   [`ContactMethod`], presets [`PicParams::perezmorales2016`]), the
+//!   independent parry checker [`check_pic`] and [`write_pic_vtu`].
 //!
 //! ```
 //! use packer_quadtree::{pack, check_packing, porosity, Domain, Grading, PackParams};
@@ -53,19 +61,27 @@
 //! (Certificação Digital 0721419/CA); Feng, Han & Owen (2003), Filling
 //! domains with disks: an advancing front approach, IJNME 56,
 //! doi:10.1002/nme.583; Samet (1990), The Design and Analysis of Spatial
-//! Data Structures (MX quadtree).
+//! Data Structures (MX quadtree); Pérez Morales, Roselló Valera, Recarey
+//! Morfa & Muniz de Farias (2016), Dense packing of general-shaped particles
+//! using analytical and minimization techniques, Rev. Cubana Cienc.
+//! Informát. 10 (supl. 1); Nelder & Mead (1965), doi:10.1093/comjnl/7.4.308.
 
 // Seeded randomised tests print their seed (house style).
 #![cfg_attr(test, allow(clippy::print_stdout))]
 
+pub mod contact2d;
+pub mod contact3d;
 mod domain;
 mod error;
 mod ga;
+pub mod gap;
 mod grading;
 mod index;
 mod io;
 mod metrics;
 mod packer;
+mod pic;
+mod shapes;
 
 pub use domain::Domain;
 pub use error::{Error, Result};
@@ -80,3 +96,7 @@ pub use packer::{
     BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,
     pack_sizes, pack_sizes_with_index, pack_with_index,
 };
+pub use pic::{
+    ContactMethod, PicPacking, PicParams, PicReport, Placed, check_pic, pack_pic, write_pic_vtu,
+};
+pub use shapes::{Geometry, Grain, GrainShape, ParryConvex, Swept};

@@ -8,6 +8,7 @@ mod fixture_integrity;
 mod levelset;
 mod packer_quadtree;
 pub mod parents;
+mod perez_morales;
 mod rounding;
 mod sph_harmonics;
 
@@ -20,6 +21,7 @@ pub fn registry() -> Vec<Case> {
     cases.extend(levelset::cases());
     cases.extend(packer_quadtree::cases());
     cases.extend(parents::cases());
+    cases.extend(perez_morales::cases());
     cases.extend(sph_harmonics::cases());
     cases
 }
@@ -33,6 +35,7 @@ pub fn expected_failures() -> Vec<ExpectedFailure> {
     list.extend_from_slice(levelset::EXPECTED_FAILURES);
     list.extend_from_slice(packer_quadtree::EXPECTED_FAILURES);
     list.extend_from_slice(parents::EXPECTED_FAILURES);
+    list.extend_from_slice(perez_morales::EXPECTED_FAILURES);
     list.extend_from_slice(sph_harmonics::EXPECTED_FAILURES);
     list
 }
