@@ -106,7 +106,7 @@ pub use labels::{
     ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, LabelImage, SkipCounts, SkipReason,
     Skipped,
 };
-pub use mesh::{MeshDistance, MeshRepair, Orientation, TriMesh};
+pub use mesh::{FAR_ERROR_CELLS, MESH_BAND_CELLS, MeshDistance, MeshRepair, Orientation, TriMesh};
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
 pub use star::{

@@ -55,6 +55,9 @@ use nalgebra::{Point3, Vector3};
 use crate::error::{Error, Result};
 use crate::grid::{Grid, GridSpec};
 
+mod banded;
+pub use banded::{FAR_ERROR_CELLS, MESH_BAND_CELLS};
+
 /// An indexed triangle mesh; triangles are counter-clockwise seen from outside.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TriMesh {

@@ -1,0 +1,347 @@
+//! Narrow-band level sets of closed meshes ([`Grid::from_mesh_banded`]): the exact signed
+//! distance near the surface, a fast-swept distance with exact signs elsewhere.
+//!
+//! # Method
+//! 1. **Band.** A node is in the band if it lies in the bounding box of some triangle grown
+//!    by `band_cells` grid spacings on every axis (rasterised per z-slab into one bit per
+//!    node). Every node within `band_cells·h` (Euclidean) of the surface is in the band, since
+//!    its closest point lies in some triangle's box; conversely every node outside the band
+//!    is farther than `band_cells·h` from every triangle. The band holds about 1.5× the nodes
+//!    of the Euclidean shell (the grown boxes are Chebyshev balls, plus the boxes' slack).
+//! 2. **Exact values** at band nodes by [`MeshDistance`], each search seeded with the closest
+//!    triangle of the node's left or lower neighbour (as [`Grid::from_mesh`] does), one z-slab
+//!    per rayon task. A slab depends on nothing but itself, so the grid is bit-identical for
+//!    any thread count.
+//! 3. **Far field (magnitude).** Fast sweeping ([`crate::reinit`], Zhao 2005, the eight
+//!    Gauss–Seidel orderings of the Godunov upwind scheme) from the band values held fixed,
+//!    then raised to at least `band_cells·h`, which every node outside the band provably
+//!    exceeds (step 1). So the far value is never closer than the band allows (a valid lower
+//!    bound of the band's clearance), and it is a first-order distance: the Godunov scheme is
+//!    exact for planar fronts and its error grows only logarithmically with the distance
+//!    travelled from the band; measured ≤ 0.6·h on the test grains (the tests assert
+//!    ≤ [`FAR_ERROR_CELLS`]·h, ≈ 0.3·h typical).
+//! 4. **Far field (sign).** With `band_cells ≥ 1`, two neighbouring nodes outside the band
+//!    have the same sign: were the surface to cross the segment between them at a point of
+//!    triangle T, both would lie within one spacing of T's box, hence in the band. So the
+//!    sign is constant on every 6-connected component of non-band nodes, and one exact
+//!    query at the component's first node (in storage order) gives it. This is exact, costs
+//!    one search per component (usually two: inside and outside), and needs neither the
+//!    grid boundary to be outside the grain nor the band values' signs.
+//!
+//! Why sweeping rather than propagating closest triangles: the sweep costs ≈ 2 ms on 45³ with
+//! no distance evaluations, and the far field only needs to be a bounded, sign-correct
+//! distance: every consumer that needs exact values near the surface reads only band nodes
+//! (see [`Grid::from_mesh_banded`]).
+//!
+//! If the band is empty (no triangle's grown box reaches the grid), there is no band to
+//! sweep from and the grid is built by [`Grid::from_mesh`], exact everywhere.
+
+use rayon::prelude::*;
+
+use super::{MeshDistance, TriMesh};
+use crate::error::{Error, Result};
+use crate::grid::{Grid, GridSpec};
+use crate::reinit::sweep;
+
+/// Bound asserted by the tests on `|value − exact|` outside the band, in grid spacings
+/// (the first-order error of the fast sweeps from the exact band; measured ≤ 0.6).
+pub const FAR_ERROR_CELLS: f64 = 1.5;
+
+/// Recommended `band_cells` of [`Grid::from_mesh_banded`]: the smallest band for which
+/// volume, area and mass properties equal [`Grid::from_mesh`]'s.
+pub const MESH_BAND_CELLS: usize = 2;
+
+/// Widening of the rasterised boxes, in grid spacings, so that rounding of the node
+/// positions never drops a node that belongs to the band.
+const RASTER_SLACK: f64 = 1e-6;
+
+/// No triangle (per-node hint slot).
+const NONE: usize = usize::MAX;
+
+/// One bit per node: `words` u64 per x-row, rows `j + ny·k`.
+pub(crate) struct BandBits {
+    words: usize,
+    bits: Vec<u64>,
+    nx: usize,
+}
+
+impl BandBits {
+    pub(crate) fn has(&self, i: usize, row: usize) -> bool {
+        self.bits[row * self.words + i / 64] >> (i % 64) & 1 == 1
+    }
+
+    fn is_empty(&self) -> bool {
+        self.bits.iter().all(|&w| w == 0)
+    }
+
+    /// Band nodes of one row, in increasing `i`.
+    fn row(&self, row: usize) -> impl Iterator<Item = usize> + '_ {
+        let words = &self.bits[row * self.words..(row + 1) * self.words];
+        let nx = self.nx;
+        words.iter().enumerate().flat_map(move |(w, &word)| {
+            let mut word = word;
+            std::iter::from_fn(move || {
+                if word == 0 {
+                    return None;
+                }
+                let b = word.trailing_zeros() as usize;
+                word &= word - 1;
+                Some(64 * w + b)
+            })
+            .filter(move |&i| i < nx)
+        })
+    }
+}
+
+/// Sets bits `lo..=hi` of a row.
+fn set_range(row: &mut [u64], lo: usize, hi: usize) {
+    let (wl, wh) = (lo / 64, hi / 64);
+    for (w, word) in row.iter_mut().enumerate().take(wh + 1).skip(wl) {
+        let a = if w == wl { lo % 64 } else { 0 };
+        let b = if w == wh { hi % 64 } else { 63 };
+        *word |= (u64::MAX >> (63 - b)) & (u64::MAX << a);
+    }
+}
+
+/// Index range `[lo, hi]` of the nodes of an axis with `n` nodes whose coordinates lie in
+/// `[lo_x, hi_x]` grown by `grow` spacings (and [`RASTER_SLACK`]); `None` if empty.
+fn node_range(
+    lo_x: f64,
+    hi_x: f64,
+    origin: f64,
+    h: f64,
+    grow: f64,
+    n: usize,
+) -> Option<[usize; 2]> {
+    let lo = ((lo_x - origin) / h - grow - RASTER_SLACK).ceil();
+    let hi = ((hi_x - origin) / h + grow + RASTER_SLACK).floor();
+    let last = (n - 1) as f64;
+    if !(lo <= hi && hi >= 0.0 && lo <= last) {
+        return None;
+    }
+    // In range and integral: the casts are exact.
+    Some([lo.max(0.0) as usize, hi.min(last) as usize])
+}
+
+impl MeshDistance {
+    /// The band of [`Grid::from_mesh_banded`] (see the module docs), and for every node
+    /// outside it nothing.
+    pub(crate) fn band(&self, spec: &GridSpec, band_cells: usize) -> BandBits {
+        let [nx, ny, nz] = spec.dims;
+        let h = spec.spacing;
+        let o = spec.origin;
+        let grow = band_cells as f64;
+        let words = nx.div_ceil(64);
+        // Triangles by the z-slabs their grown boxes reach (triangle order: deterministic).
+        let mut boxes: Vec<[[usize; 2]; 3]> = Vec::with_capacity(self.a.len());
+        let mut slabs: Vec<Vec<u32>> = vec![Vec::new(); nz];
+        for t in 0..self.a.len() {
+            let lo = self.a[t].inf(&self.b[t]).inf(&self.c[t]);
+            let hi = self.a[t].sup(&self.b[t]).sup(&self.c[t]);
+            let r = |a: usize| node_range(lo[a], hi[a], o[a], h, grow, spec.dims[a]);
+            if let (Some(x), Some(y), Some(z)) = (r(0), r(1), r(2)) {
+                let id = boxes.len() as u32;
+                boxes.push([x, y, z]);
+                for slab in &mut slabs[z[0]..=z[1]] {
+                    slab.push(id);
+                }
+            }
+        }
+        let mut bits = vec![0u64; words * ny * nz];
+        bits.par_chunks_mut(words * ny)
+            .zip(slabs.par_iter())
+            .for_each(|(slab, ids)| {
+                for &id in ids {
+                    let [x, y, _] = boxes[id as usize];
+                    for j in y[0]..=y[1] {
+                        set_range(&mut slab[j * words..(j + 1) * words], x[0], x[1]);
+                    }
+                }
+            });
+        BandBits { words, bits, nx }
+    }
+
+    /// Exact signed distances at the band nodes of z-slab `k` (other entries untouched),
+    /// each search seeded with the closest triangle of the left neighbour, else of the
+    /// neighbour below in y, else of the previous band node of the slab.
+    fn band_slab(&self, spec: &GridSpec, band: &BandBits, k: usize, slab: &mut [f64]) {
+        let [nx, ny, _] = spec.dims;
+        let mut prev = vec![NONE; nx];
+        let mut cur = vec![NONE; nx];
+        let mut last = 0;
+        for j in 0..ny {
+            for i in band.row(j + ny * k) {
+                let hint = if i > 0 && cur[i - 1] != NONE {
+                    cur[i - 1]
+                } else if prev[i] != NONE {
+                    prev[i]
+                } else {
+                    last
+                };
+                let (d, t) = self.signed_distance_from(&spec.node(i, j, k).coords, hint);
+                slab[i + nx * j] = d;
+                cur[i] = t;
+                last = t;
+            }
+            std::mem::swap(&mut prev, &mut cur);
+            cur.fill(NONE);
+        }
+    }
+}
+
+impl Grid {
+    /// Signed distance of a closed triangle mesh, exact in a band about the surface and a
+    /// sign-correct first-order distance beyond it: ≈ 10× faster than [`Grid::from_mesh`]
+    /// on 45³ grains of 5k–50k triangles (method and choices: [`crate::mesh`], section
+    /// *Banded construction*).
+    ///
+    /// * Every node within `band_cells·h` of the surface (and every node of a triangle's
+    ///   bounding box grown by `band_cells` spacings) holds exactly [`Grid::from_mesh`]'s
+    ///   value (the same exact search; equal to 1e-12, tested).
+    /// * Every other node has the exact sign and a magnitude of at least `band_cells·h`
+    ///   (a true lower bound there), swept from the band: within [`FAR_ERROR_CELLS`]·h of
+    ///   the exact distance on the tested grains.
+    ///
+    /// With `band_cells ≥ 2` ([`MESH_BAND_CELLS`]) the nodes that [`Grid::volume`],
+    /// [`Grid::area`], [`Grid::mass_properties`], [`Grid::marching_cubes`] and
+    /// [`Grid::surface`] read (corners of the cells the surface crosses and their
+    /// neighbours for the gradients) are band nodes, so those results equal
+    /// [`Grid::from_mesh`]'s, as does contact through [`Grid::sample`] within about one
+    /// spacing of the surface. Use [`Grid::from_mesh`] when values far from the surface must
+    /// be exact (e.g. [`Grid::inscribed_sphere`] of a thick grain to better than a grid
+    /// spacing, or distance queries far outside).
+    ///
+    /// Z-slabs of the band run on the current rayon pool; the result is bit-identical for any
+    /// number of threads.
+    ///
+    /// # Errors
+    /// Invalid spec; [`Error::InvalidParameter`] if `band_cells` is 0; as
+    /// [`MeshDistance::new`].
+    pub fn from_mesh_banded(spec: GridSpec, mesh: &TriMesh, band_cells: usize) -> Result<Self> {
+        spec.validate()?;
+        if band_cells == 0 {
+            return Err(Error::InvalidParameter {
+                name: "band_cells",
+                value: 0.0,
+                requirement: "at least 1 (2 or more keeps volume, area and mass properties exact)",
+            });
+        }
+        let md = MeshDistance::new(mesh)?;
+        let band = md.band(&spec, band_cells);
+        if band.is_empty() {
+            return Self::from_mesh(spec, mesh);
+        }
+        let [nx, ny, nz] = spec.dims;
+        let plane = nx * ny;
+        let mut values = vec![0.0; spec.len()];
+        values
+            .par_chunks_mut(plane)
+            .enumerate()
+            .for_each(|(k, slab)| md.band_slab(&spec, &band, k, slab));
+
+        // Far signs: one exact query per 6-connected component of non-band nodes.
+        let h = spec.spacing;
+        let mut sign = vec![0i8; spec.len()];
+        let mut stack = Vec::new();
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    let g = i + nx * (j + ny * k);
+                    if band.has(i, j + ny * k) || sign[g] != 0 {
+                        continue;
+                    }
+                    let s = if md.signed_distance(&spec.node(i, j, k)) < 0.0 {
+                        -1
+                    } else {
+                        1
+                    };
+                    sign[g] = s;
+                    stack.push([i, j, k]);
+                    while let Some([a, b, c]) = stack.pop() {
+                        let steps = [
+                            (a > 0).then(|| [a - 1, b, c]),
+                            (a + 1 < nx).then(|| [a + 1, b, c]),
+                            (b > 0).then(|| [a, b - 1, c]),
+                            (b + 1 < ny).then(|| [a, b + 1, c]),
+                            (c > 0).then(|| [a, b, c - 1]),
+                            (c + 1 < nz).then(|| [a, b, c + 1]),
+                        ];
+                        for [x, y, z] in steps.into_iter().flatten() {
+                            let q = x + nx * (y + ny * z);
+                            if sign[q] == 0 && !band.has(x, y + ny * z) {
+                                sign[q] = s;
+                                stack.push([x, y, z]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        // Sources of the sweep: the band, and, if the mesh leaves the grid box (so closest
+        // points may lie outside the grid), every far node of the boundary layer and the
+        // inside far nodes of the next layer. Exact boundary values make the swept distance
+        // the true one (closest points outside are reached through the boundary), and the
+        // surface integrals close a cut grain with padding (`crate::surface`), which makes
+        // the inside nodes of the two outer layers corners of crossed cells or their
+        // neighbours.
+        let mut exact = vec![false; spec.len()];
+        let root = &md.nodes[0].bounds;
+        let corner = spec.max_corner();
+        let contained = (0..3).all(|a| root.lo[a] >= spec.origin[a] && root.hi[a] <= corner[a]);
+        if !contained {
+            let layer = |i: usize, n: usize| usize::min(i, n - 1 - i);
+            let mut hint = 0;
+            for k in 0..nz {
+                for j in 0..ny {
+                    for i in 0..nx {
+                        let g = i + nx * (j + ny * k);
+                        let depth = layer(i, nx).min(layer(j, ny)).min(layer(k, nz));
+                        if sign[g] != 0 && (depth == 0 || (depth == 1 && sign[g] < 0)) {
+                            let (d, t) = md.signed_distance_from(&spec.node(i, j, k).coords, hint);
+                            values[g] = d;
+                            exact[g] = true;
+                            hint = t;
+                        }
+                    }
+                }
+            }
+        }
+
+        // Far magnitudes: fast sweeping from the fixed sources on the padded layout of
+        // `sweep`, at least the band width.
+        let (px, py) = (nx + 2, ny + 2);
+        let pad = |i: usize, j: usize, k: usize| (i + 1) + px * ((j + 1) + py * (k + 1));
+        let mut u = vec![f64::INFINITY; px * py * (nz + 2)];
+        let mut fixed = vec![true; u.len()];
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    let (g, p) = (i + nx * (j + ny * k), pad(i, j, k));
+                    if sign[g] == 0 || exact[g] {
+                        u[p] = values[g].abs();
+                    } else {
+                        fixed[p] = false;
+                    }
+                }
+            }
+        }
+        sweep(spec.dims, h, &mut u, &fixed);
+        let floor = band_cells as f64 * h;
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    let g = i + nx * (j + ny * k);
+                    if sign[g] != 0 && !exact[g] {
+                        let v = u[pad(i, j, k)].max(floor);
+                        values[g] = if sign[g] < 0 { -v } else { v };
+                    }
+                }
+            }
+        }
+        Self::new(spec, values)
+    }
+}
+
+#[cfg(test)]
+mod tests;
