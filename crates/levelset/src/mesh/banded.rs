@@ -38,7 +38,7 @@
 
 use rayon::prelude::*;
 
-use super::{MeshDistance, TriMesh};
+use super::{MeshDistance, TriMesh, closest_on_triangle};
 use crate::error::{Error, Result};
 use crate::grid::{Grid, GridSpec};
 use crate::reinit::sweep;
@@ -49,20 +49,16 @@ pub const FAR_ERROR_CELLS: f64 = 1.5;
 
 /// Recommended `band_cells` of [`Grid::from_mesh_banded`]: the smallest band for which
 /// volume, area and mass properties equal [`Grid::from_mesh`]'s.
-pub const MESH_BAND_CELLS: usize = 2;
+pub const MESH_BAND_CELLS: usize = 3;
 
 /// Widening of the rasterised boxes, in grid spacings, so that rounding of the node
 /// positions never drops a node that belongs to the band.
 const RASTER_SLACK: f64 = 1e-6;
 
-/// No triangle (per-node hint slot).
-const NONE: usize = usize::MAX;
-
 /// One bit per node: `words` u64 per x-row, rows `j + ny·k`.
 pub(crate) struct BandBits {
     words: usize,
     bits: Vec<u64>,
-    nx: usize,
 }
 
 impl BandBits {
@@ -72,34 +68,6 @@ impl BandBits {
 
     fn is_empty(&self) -> bool {
         self.bits.iter().all(|&w| w == 0)
-    }
-
-    /// Band nodes of one row, in increasing `i`.
-    fn row(&self, row: usize) -> impl Iterator<Item = usize> + '_ {
-        let words = &self.bits[row * self.words..(row + 1) * self.words];
-        let nx = self.nx;
-        words.iter().enumerate().flat_map(move |(w, &word)| {
-            let mut word = word;
-            std::iter::from_fn(move || {
-                if word == 0 {
-                    return None;
-                }
-                let b = word.trailing_zeros() as usize;
-                word &= word - 1;
-                Some(64 * w + b)
-            })
-            .filter(move |&i| i < nx)
-        })
-    }
-}
-
-/// Sets bits `lo..=hi` of a row.
-fn set_range(row: &mut [u64], lo: usize, hi: usize) {
-    let (wl, wh) = (lo / 64, hi / 64);
-    for (w, word) in row.iter_mut().enumerate().take(wh + 1).skip(wl) {
-        let a = if w == wl { lo % 64 } else { 0 };
-        let b = if w == wh { hi % 64 } else { 63 };
-        *word |= (u64::MAX >> (63 - b)) & (u64::MAX << a);
     }
 }
 
@@ -124,9 +92,9 @@ fn node_range(
 }
 
 impl MeshDistance {
-    /// The band of [`Grid::from_mesh_banded`] (see the module docs), and for every node
-    /// outside it nothing.
-    pub(crate) fn band(&self, spec: &GridSpec, band_cells: usize) -> BandBits {
+    /// The band of [`Grid::from_mesh_banded`] (nodes within `band_cells·h` of the surface)
+    /// and the grid values, exact at band nodes and 0 elsewhere (see the module docs).
+    pub(crate) fn band(&self, spec: &GridSpec, band_cells: usize) -> (BandBits, Vec<f64>) {
         let [nx, ny, nz] = spec.dims;
         let h = spec.spacing;
         let o = spec.origin;
@@ -134,6 +102,7 @@ impl MeshDistance {
         let words = nx.div_ceil(64);
         // Triangles by the z-slabs their grown boxes reach (triangle order: deterministic).
         let mut boxes: Vec<[[usize; 2]; 3]> = Vec::with_capacity(self.a.len());
+        let mut ids: Vec<u32> = Vec::with_capacity(self.a.len());
         let mut slabs: Vec<Vec<u32>> = vec![Vec::new(); nz];
         for t in 0..self.a.len() {
             let lo = self.a[t].inf(&self.b[t]).inf(&self.c[t]);
@@ -142,50 +111,51 @@ impl MeshDistance {
             if let (Some(x), Some(y), Some(z)) = (r(0), r(1), r(2)) {
                 let id = boxes.len() as u32;
                 boxes.push([x, y, z]);
+                ids.push(t as u32);
                 for slab in &mut slabs[z[0]..=z[1]] {
                     slab.push(id);
                 }
             }
         }
+        let plane = nx * ny;
+        let width2 = (grow * h).powi(2);
         let mut bits = vec![0u64; words * ny * nz];
+        let mut values = vec![0.0; spec.len()];
         bits.par_chunks_mut(words * ny)
+            .zip(values.par_chunks_mut(plane))
             .zip(slabs.par_iter())
-            .for_each(|(slab, ids)| {
-                for &id in ids {
+            .enumerate()
+            .for_each(|(k, ((slab_bits, slab), list))| {
+                // Closest candidate per node: squared distance and triangle.
+                let mut best = vec![(f64::INFINITY, u32::MAX); plane];
+                for &id in list {
                     let [x, y, _] = boxes[id as usize];
+                    let t = ids[id as usize] as usize;
+                    let (a, b, c) = (&self.a[t], &self.b[t], &self.c[t]);
                     for j in y[0]..=y[1] {
-                        set_range(&mut slab[j * words..(j + 1) * words], x[0], x[1]);
+                        for i in x[0]..=x[1] {
+                            let q = spec.node(i, j, k).coords;
+                            let (cp, _) = closest_on_triangle(&q, a, b, c);
+                            let d2 = (q - cp).norm_squared();
+                            let e = &mut best[i + nx * j];
+                            if d2 < e.0 {
+                                *e = (d2, t as u32);
+                            }
+                        }
+                    }
+                }
+                for (n, &(d2, t)) in best.iter().enumerate() {
+                    if d2 <= width2 {
+                        let (i, j) = (n % nx, n / nx);
+                        let q = spec.node(i, j, k).coords;
+                        let t = t as usize;
+                        let (cp, f) = closest_on_triangle(&q, &self.a[t], &self.b[t], &self.c[t]);
+                        slab[n] = self.signed(&q, (t, cp, f));
+                        slab_bits[j * words + i / 64] |= 1 << (i % 64);
                     }
                 }
             });
-        BandBits { words, bits, nx }
-    }
-
-    /// Exact signed distances at the band nodes of z-slab `k` (other entries untouched),
-    /// each search seeded with the closest triangle of the left neighbour, else of the
-    /// neighbour below in y, else of the previous band node of the slab.
-    fn band_slab(&self, spec: &GridSpec, band: &BandBits, k: usize, slab: &mut [f64]) {
-        let [nx, ny, _] = spec.dims;
-        let mut prev = vec![NONE; nx];
-        let mut cur = vec![NONE; nx];
-        let mut last = 0;
-        for j in 0..ny {
-            for i in band.row(j + ny * k) {
-                let hint = if i > 0 && cur[i - 1] != NONE {
-                    cur[i - 1]
-                } else if prev[i] != NONE {
-                    prev[i]
-                } else {
-                    last
-                };
-                let (d, t) = self.signed_distance_from(&spec.node(i, j, k).coords, hint);
-                slab[i + nx * j] = d;
-                cur[i] = t;
-                last = t;
-            }
-            std::mem::swap(&mut prev, &mut cur);
-            cur.fill(NONE);
-        }
+        (BandBits { words, bits }, values)
     }
 }
 
@@ -227,17 +197,11 @@ impl Grid {
             });
         }
         let md = MeshDistance::new(mesh)?;
-        let band = md.band(&spec, band_cells);
+        let (band, mut values) = md.band(&spec, band_cells);
         if band.is_empty() {
             return Self::from_mesh(spec, mesh);
         }
         let [nx, ny, nz] = spec.dims;
-        let plane = nx * ny;
-        let mut values = vec![0.0; spec.len()];
-        values
-            .par_chunks_mut(plane)
-            .enumerate()
-            .for_each(|(k, slab)| md.band_slab(&spec, &band, k, slab));
 
         // Far signs: one exact query per 6-connected component of non-band nodes.
         let h = spec.spacing;
