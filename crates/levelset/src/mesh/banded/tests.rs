@@ -81,11 +81,6 @@ fn band_is_exact_and_far_field_is_bounded() {
                     }
                 }
             }
-            eprintln!(
-                "{name} B{band_cells}: band {in_band}, far {far} (out {}, in {}), worst far \
-                 error {worst_far:.3}·h",
-                signs[0], signs[1]
-            );
             assert!(
                 worst_far <= FAR_ERROR_CELLS,
                 "{name} B{band_cells}: {worst_far}·h"
