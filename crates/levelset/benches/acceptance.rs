@@ -1,12 +1,14 @@
 //! Acceptance benchmarks of issue 3 on 45³ grids: star build (incl. redistancing; default
 //! band build and the seed's full sweep),
 //! marching cubes, volume + area + inertia, contact of 1,000 nodes; and the user-grain mesh
-//! path (`mesh_grain` group): `prepare_closed` and `Grid::from_mesh` on a 45³ grid with
-//! margin 1.1 for lumpy grains of ≈ 5k and ≈ 50k triangles.
+//! path (`mesh_grain` group): `prepare_closed`, `Grid::from_mesh` (exact everywhere) and
+//! `Grid::from_mesh_banded` (exact in a band of `MESH_BAND_CELLS`, on the default pool and on
+//! one thread) on a 45³ grid with margin 1.1 for lumpy grains of ≈ 5k and ≈ 50k triangles.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use levelset::{
-    Body, Grid, GridSpec, Orientation, Redistance, Sphere, StarParams, TriMesh, contact_into,
+    Body, Grid, GridSpec, MESH_BAND_CELLS, Orientation, Redistance, Sphere, StarParams, TriMesh,
+    contact_into,
 };
 use nalgebra::{Isometry3, Point3, Unit, Vector3};
 use std::hint::black_box;
@@ -171,6 +173,24 @@ fn mesh_grain(c: &mut Criterion) {
         });
         group.bench_function(format!("from_mesh_45_{n}"), |b| {
             b.iter(|| Grid::from_mesh(spec, black_box(&mesh)).expect("grid"))
+        });
+        // Exact in a band of MESH_BAND_CELLS, swept beyond: on the default pool (z-slabs of
+        // the band in parallel) and on one thread (callers that parallelise over grains).
+        group.bench_function(format!("from_mesh_banded_45_{n}"), |b| {
+            b.iter(|| {
+                Grid::from_mesh_banded(spec, black_box(&mesh), MESH_BAND_CELLS).expect("grid")
+            })
+        });
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .expect("pool");
+        group.bench_function(format!("from_mesh_banded_45_{n}_1thread"), |b| {
+            b.iter(|| {
+                one.install(|| {
+                    Grid::from_mesh_banded(spec, black_box(&mesh), MESH_BAND_CELLS).expect("grid")
+                })
+            })
         });
     }
     group.finish();

@@ -9,7 +9,9 @@
 //!   via [`Grid::from_shape`]; [`Superellipsoid`] and any star-shaped radius function via
 //!   [`Grid::from_star`] (cube-map direction table, narrow-band second-order distances and a
 //!   closest-point interior, or the seed's full fast sweeping: [`StarParams`], [`Redistance`]);
-//!   closed triangle meshes via [`Grid::from_mesh`] ([`MeshDistance`]: BVH + pseudonormals),
+//!   closed triangle meshes via [`Grid::from_mesh`] ([`MeshDistance`]: BVH + pseudonormals;
+//!   exact everywhere) or [`Grid::from_mesh_banded`] (exact within a band of
+//!   [`MESH_BAND_CELLS`], fast-swept beyond; same volume, area and mass properties),
 //!   users' grain meshes made closed, manifold and outward by [`TriMesh::prepare_closed`]
 //!   (policy [`Orientation`], report [`MeshRepair`]) and framed by [`TriMesh::centroid`] and
 //!   [`GridSpec::around_points`];
@@ -106,7 +108,7 @@ pub use labels::{
     ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, LabelImage, SkipCounts, SkipReason,
     Skipped,
 };
-pub use mesh::{MeshDistance, MeshRepair, Orientation, TriMesh};
+pub use mesh::{FAR_ERROR_CELLS, MESH_BAND_CELLS, MeshDistance, MeshRepair, Orientation, TriMesh};
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
 pub use star::{

@@ -11,8 +11,20 @@
 //! [`Grid::from_mesh`] seeds every node's search with the closest triangle of its
 //! neighbour, whose exact distance is a tight bound; the search then only proves it. Far
 //! from a finely meshed surface that proof still visits many boxes (all those closer than
-//! the answer), which dominates the cost of a 45³ grid; the values are exact everywhere
-//! rather than exact in a band and propagated beyond it.
+//! the answer), which dominates the cost of a 45³ grid; the values are exact everywhere.
+//!
+//! # Banded construction
+//! [`Grid::from_mesh_banded`] is exact only within `band_cells·h` of the surface and fast
+//! beyond: each triangle is scattered over the nodes of its bounding box grown by the band
+//! (no proof searches; a node's closest candidate is provably its closest triangle exactly
+//! when it lies within the band), the far field is fast-swept from the band
+//! ([`crate::reinit`]) and raised to at least the band width (a true lower bound there), and
+//! far signs come from one exact query per connected region of non-band nodes (the surface
+//! cannot pass between two neighbouring non-band nodes). With [`MESH_BAND_CELLS`] = 3 cells
+//! the volume, area, mass properties and marching-cubes surface equal [`Grid::from_mesh`]'s;
+//! far values are within [`FAR_ERROR_CELLS`]·h of the exact distance on the tested grains.
+//! Use it for grains (≈ 3–6× faster on 45³); keep [`Grid::from_mesh`] for exact values far
+//! from the surface.
 //!
 //! # User meshes
 //! A grain scanned or exported by someone else (STL, OBJ: [`crate::io`]) is a triangle
@@ -54,6 +66,9 @@ use nalgebra::{Point3, Vector3};
 
 use crate::error::{Error, Result};
 use crate::grid::{Grid, GridSpec};
+
+mod banded;
+pub use banded::{FAR_ERROR_CELLS, MESH_BAND_CELLS};
 
 /// An indexed triangle mesh; triangles are counter-clockwise seen from outside.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -620,6 +635,7 @@ enum Feature {
 }
 
 /// Ericson 2005, `ClosestPtPointTriangle` (Sec. 5.1.5), with the Voronoi region.
+#[inline]
 fn closest_on_triangle(
     p: &Vector3<f64>,
     a: &Vector3<f64>,

@@ -690,7 +690,7 @@ fn lumpy(u: Vector3<f64>) -> f64 {
     0.8 + 0.12 * (3.0 * theta).sin() * (2.0 * phi).cos() + 0.05 * (5.0 * phi).sin() * theta.sin()
 }
 /// The lumpy grain as a latitude–longitude mesh of 4·m·(m − 1) triangles.
-fn lumpy_mesh(m: usize) -> TriMesh {
+pub(crate) fn lumpy_mesh(m: usize) -> TriMesh {
     let seg = 2 * m;
     let point = |theta: f64, phi: f64| {
         let u = Vector3::new(
