@@ -719,38 +719,55 @@ impl<const D: usize> Packer<'_, D> {
     /// `a` of `P`, its `neighbours` nearest placed elements (surface
     /// distance) and the walls within reach are the partners; every pair
     /// (3D) or single partner (2D) reachable together with `a` gives up to
-    /// two closed-form centres of a mobile element tangent to all, and the
-    /// cluster is placed with each of its elements at such a centre.
+    /// two closed-form centres `y` of a mobile element tangent to all (kept
+    /// if it clears `a`'s partners), and the cluster is placed rigidly in
+    /// its drawn orientation with the element facing the partners (the
+    /// smallest offset along the sum of the contact normals) at `y`.
+    /// Candidates are tried lowest first against the placed elements near
+    /// `P`, the element that rejected the previous candidate first.
     fn around_approx(&self, el: &Elements<D>, p: u32, m: &Grain<D>) -> Option<SVector<f64, D>> {
         let Geometry::Swept(me) = &m.geometry else {
             return None;
         };
         let s = me[0].radius;
+        let rm = m.circumradius;
         let side = self.params.side;
-        let tol = self.tol_rel * m.circumradius;
+        let tol = self.tol_rel * rm;
         let last = D - 1;
         let lo_e = el.first[p as usize] as usize;
         let hi_e = el
             .first
             .get(p as usize + 1)
             .map_or(el.centre.len(), |&k| k as usize);
+        // Placed elements that may meet the cluster at any candidate (the
+        // candidates lie within `R_P + R_m` of P's centre) or be a partner.
+        let pc = self.grains[p as usize].centre;
+        let reach = self.grains[p as usize].grain.circumradius + 2.0 * rm + el.rmax;
+        let mut local: Vec<(SVector<f64, D>, f64, u32)> = Vec::new();
+        el.grid.query(&pc, reach, |q| {
+            let c = el.centre[q as usize];
+            if (c - pc).norm_squared() <= reach * reach {
+                local.push((c, el.radius[q as usize], q));
+            }
+        });
         let mut ys: Vec<(SVector<f64, D>, SVector<f64, D>)> = Vec::new();
         let mut near: Vec<(f64, Atom)> = Vec::new();
+        let mut wraps: Vec<Wrap<D>> = Vec::new();
         let mut tmp = Vec::with_capacity(2);
         for a in lo_e..hi_e {
             let ca = el.centre[a];
             let ra = el.radius[a];
             near.clear();
-            el.grid.query(&ca, ra + 2.0 * s + el.rmax, |q| {
-                if q as usize == a {
-                    return;
+            for &(c, r, q) in &local {
+                // Siblings before `a` already had their turn.
+                if (q as usize) <= a && (q as usize) >= lo_e {
+                    continue;
                 }
-                let d = (el.centre[q as usize] - ca).norm();
-                let g = d - el.radius[q as usize] - ra;
+                let g = (c - ca).norm() - r - ra;
                 if g <= 2.0 * s {
                     near.push((g, Atom::Elem(q)));
                 }
-            });
+            }
             if near.len() > self.neighbours {
                 near.select_nth_unstable_by(self.neighbours, |x, y| {
                     x.0.total_cmp(&y.0).then(atom_id(x.1).cmp(&atom_id(y.1)))
@@ -765,68 +782,65 @@ impl<const D: usize> Packer<'_, D> {
                     }
                 }
             }
+            wraps.clear();
+            wraps.extend(near.iter().map(|&(_, b)| self.atom_wrap(el, b, s)));
+            let clear = |y: &SVector<f64, D>| {
+                near.iter().all(|&(_, q)| match q {
+                    Atom::Elem(q) => {
+                        let min = el.radius[q as usize] + s - tol;
+                        (el.centre[q as usize] - y).norm_squared() >= min * min
+                    }
+                    Atom::Wall { .. } => true,
+                })
+            };
             let wa = Wrap::Sphere(ca, ra + s);
-            if D == 2 {
-                for &(_, b) in &near {
-                    intersect(&[wa, self.atom_wrap(el, b, s)], &mut tmp);
-                    for y in &tmp {
-                        let n = (y - ca).normalize() + (y - self.atom_point(el, b, y)).normalize();
+            for (i, &(_, b)) in near.iter().enumerate() {
+                let pairs = if D == 2 { i..i + 1 } else { i + 1..near.len() };
+                for k in pairs {
+                    let c = near[k].1;
+                    if D == 2 {
+                        intersect(&[wa, wraps[i]], &mut tmp);
+                    } else if self.atoms_reach(el, b, c, s) {
+                        intersect(&[wa, wraps[i], wraps[k]], &mut tmp);
+                    } else {
+                        continue;
+                    }
+                    for y in tmp.iter().filter(|y| clear(y)) {
+                        let mut n = (y - ca).normalize() + (y - self.atom_point(el, b, y)).normalize();
+                        if D == 3 {
+                            n += (y - self.atom_point(el, c, y)).normalize();
+                        }
                         ys.push((*y, n));
                     }
                 }
-            } else {
-                for (i, &(_, b)) in near.iter().enumerate() {
-                    for &(_, c) in &near[i + 1..] {
-                        if self.atoms_reach(el, b, c, s) {
-                            let w = [wa, self.atom_wrap(el, b, s), self.atom_wrap(el, c, s)];
-                            intersect(&w, &mut tmp);
-                            for y in &tmp {
-                                let n = (y - ca).normalize()
-                                    + (y - self.atom_point(el, b, y)).normalize()
-                                    + (y - self.atom_point(el, c, y)).normalize();
-                                ys.push((*y, n));
-                            }
-                        }
-                    }
-                }
             }
         }
-        // The cluster with each of its elements at each centre, the two
-        // facing the partners (smallest offset along `y − centroid`) only:
-        // the others push the cluster into them.
-        let mut cands: Vec<(f64, SVector<f64, D>)> = Vec::with_capacity(2 * ys.len());
-        let mut order: Vec<(f64, usize)> = Vec::with_capacity(me.len());
-        let facing: usize = std::env::var("FACING").ok().and_then(|v| v.parse().ok()).unwrap_or(2);
+        // The cluster with its element facing the partners at each centre.
+        let mut cands: Vec<(f64, SVector<f64, D>)> = Vec::with_capacity(ys.len());
         for &(y, n) in &ys {
-            order.clear();
-            order.extend(me.iter().enumerate().map(|(j, e)| (e.a.dot(&n), j)));
-            order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            for &(_, j) in order.iter().take(facing) {
-                let x = y - me[j].a;
-                if (0..D).all(|i| x[i] + m.lo[i] >= -tol && x[i] + m.hi[i] <= side + tol) {
-                    cands.push((x[last], x));
+            let mut j = 0;
+            let mut best = f64::INFINITY;
+            for (k, e) in me.iter().enumerate() {
+                let v = e.a.dot(&n);
+                if v < best {
+                    best = v;
+                    j = k;
                 }
+            }
+            let x = y - me[j].a;
+            if (0..D).all(|i| x[i] + m.lo[i] >= -tol && x[i] + m.hi[i] <= side + tol) {
+                cands.push((x[last], x));
             }
         }
         cands.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        // Placed elements that may meet the cluster at any candidate: the
-        // candidates lie within `R_P + R_m` of P's centre.
-        let pc = self.grains[p as usize].centre;
-        let reach = self.grains[p as usize].grain.circumradius + 2.0 * m.circumradius + el.rmax;
-        let mut local: Vec<(SVector<f64, D>, f64)> = Vec::new();
-        el.grid.query(&pc, reach, |q| {
-            let c = el.centre[q as usize];
-            if (c - pc).norm_squared() <= reach * reach {
-                local.push((c, el.radius[q as usize]));
-            }
-        });
-        let rm = m.circumradius;
-        if std::env::var("DBG").is_ok() { eprintln!("p {p} ys {} cands {} local {}", ys.len(), cands.len(), local.len()); }
+        DBG_CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        DBG_CANDS.fetch_add(cands.len(), std::sync::atomic::Ordering::Relaxed);
+        DBG_LOCAL.fetch_add(local.len(), std::sync::atomic::Ordering::Relaxed);
         let mut culprit = 0usize;
         'cand: for (_, x) in cands {
-            // The element that rejected the previous candidate first.
+            DBG_TRIED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             for k in std::iter::once(culprit).chain(0..local.len()) {
-                let Some(&(c, r)) = local.get(k) else {
+                let Some(&(c, r, _)) = local.get(k) else {
                     continue;
                 };
                 let rel = c - x;
@@ -842,6 +856,7 @@ impl<const D: usize> Packer<'_, D> {
                     }
                 }
             }
+            DBG_OK.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             return Some(x);
         }
         None
@@ -885,6 +900,11 @@ impl<const D: usize> Packer<'_, D> {
     }
 }
 
+pub static DBG_CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static DBG_CANDS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static DBG_LOCAL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static DBG_OK: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub static DBG_TRIED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 /// A sort key of an [`Atom`] (ties of the nearest-element selection).
 fn atom_id(a: Atom) -> u64 {
     match a {
@@ -1043,7 +1063,7 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
             failed_r[entry.1 as usize] = big_r;
             // Does the smallest grain of this orientation fit around P?
             let small = scaled(&ms[0], params.radius_min / big_r);
-            let keep = small
+            let keep = std::env::var("NOSMALL").is_err() && small
                 .as_ref()
                 .is_some_and(|s| pk.around(entry.1, s).is_some());
             if !keep {
@@ -1062,6 +1082,10 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
                 rejects_in_row += 1;
             }
         }
+    }
+    if std::env::var("DBG").is_ok() {
+        use std::sync::atomic::Ordering::Relaxed;
+        eprintln!("calls {} ok {} cands {} tried {} local {} rejected {rejected}", DBG_CALLS.load(Relaxed), DBG_OK.load(Relaxed), DBG_CANDS.load(Relaxed), DBG_TRIED.load(Relaxed), DBG_LOCAL.load(Relaxed));
     }
     Ok(PicPacking {
         grains: pk.grains,
