@@ -34,7 +34,7 @@ use crate::contact2d::{self, Solutions, Wrapper2};
 use crate::contact3d::{self, Wrapper3};
 use crate::error::{Error, Result};
 use crate::gap::{self, Obstacle};
-use crate::shapes::{Geometry, Grain, GrainShape, ParryConvex, Swept};
+use crate::shapes::{Geometry, Grain, GrainShape, ParryConvex};
 
 /// How the contact positions are computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -744,10 +744,23 @@ impl<const D: usize> Packer<'_, D> {
         let pc = self.grains[p as usize].centre;
         let reach = self.grains[p as usize].grain.circumradius + 2.0 * rm + el.rmax;
         let mut local: Vec<(SVector<f64, D>, f64, u32)> = Vec::new();
-        el.grid.query(&pc, reach, |q| {
-            let c = el.centre[q as usize];
-            if (c - pc).norm_squared() <= reach * reach {
-                local.push((c, el.radius[q as usize], q));
+        // Through the (coarser) grain grid, then each grain's elements.
+        self.grid.query(&pc, reach + self.rmax_placed, |g| {
+            let gp = &self.grains[g as usize];
+            let rg = reach + gp.grain.circumradius;
+            if (gp.centre - pc).norm_squared() > rg * rg {
+                return;
+            }
+            let lo = el.first[g as usize] as usize;
+            let hi = el
+                .first
+                .get(g as usize + 1)
+                .map_or(el.centre.len(), |&k| k as usize);
+            for q in lo..hi {
+                let c = el.centre[q];
+                if (c - pc).norm_squared() <= reach * reach {
+                    local.push((c, el.radius[q], q as u32));
+                }
             }
         });
         let mut ys: Vec<(SVector<f64, D>, SVector<f64, D>)> = Vec::new();
@@ -763,9 +776,10 @@ impl<const D: usize> Packer<'_, D> {
                 if (q as usize) <= a && (q as usize) >= lo_e {
                     continue;
                 }
-                let g = (c - ca).norm() - r - ra;
-                if g <= 2.0 * s {
-                    near.push((g, Atom::Elem(q)));
+                let d2 = (c - ca).norm_squared();
+                let lim = r + ra + 2.0 * s;
+                if d2 <= lim * lim {
+                    near.push((d2.sqrt() - r - ra, Atom::Elem(q)));
                 }
             }
             if near.len() > self.neighbours {
@@ -800,6 +814,13 @@ impl<const D: usize> Packer<'_, D> {
                     let c = near[k].1;
                     if D == 2 {
                         intersect(&[wa, wraps[i]], &mut tmp);
+                    } else if let (Wrap::Sphere(c1, r1), Wrap::Sphere(c2, r2)) =
+                        (wraps[i], wraps[k])
+                    {
+                        if (c1 - c2).norm_squared() > (r1 + r2) * (r1 + r2) {
+                            continue;
+                        }
+                        tangent3(&ca, ra + s, &c1, r1, &c2, r2, &mut tmp);
                     } else if self.atoms_reach(el, b, c, s) {
                         intersect(&[wa, wraps[i], wraps[k]], &mut tmp);
                     } else {
@@ -833,12 +854,8 @@ impl<const D: usize> Packer<'_, D> {
             }
         }
         cands.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        DBG_CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        DBG_CANDS.fetch_add(cands.len(), std::sync::atomic::Ordering::Relaxed);
-        DBG_LOCAL.fetch_add(local.len(), std::sync::atomic::Ordering::Relaxed);
         let mut culprit = 0usize;
         'cand: for (_, x) in cands {
-            DBG_TRIED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             for k in std::iter::once(culprit).chain(0..local.len()) {
                 let Some(&(c, r, _)) = local.get(k) else {
                     continue;
@@ -856,7 +873,6 @@ impl<const D: usize> Packer<'_, D> {
                     }
                 }
             }
-            DBG_OK.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             return Some(x);
         }
         None
@@ -900,11 +916,50 @@ impl<const D: usize> Packer<'_, D> {
     }
 }
 
-pub static DBG_CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static DBG_CANDS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static DBG_LOCAL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static DBG_OK: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static DBG_TRIED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+/// Centres `x` with `|x − c_i| = ρ_i` for three spheres (3D only; the
+/// closed form of [`contact3d::intersect`] without its conversions): none
+/// for collinear centres or no intersection, one when tangent.
+fn tangent3<const D: usize>(
+    c0: &SVector<f64, D>,
+    rho0: f64,
+    c1: &SVector<f64, D>,
+    rho1: f64,
+    c2: &SVector<f64, D>,
+    rho2: f64,
+    out: &mut Vec<SVector<f64, D>>,
+) {
+    out.clear();
+    let cross = |a: &SVector<f64, D>, b: &SVector<f64, D>| {
+        SVector::<f64, D>::from_fn(|i, _| {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            a[j] * b[k] - a[k] * b[j]
+        })
+    };
+    let a1 = c1 - c0;
+    let a2 = c2 - c0;
+    let b1 = 0.5 * (rho0 * rho0 - rho1 * rho1 + a1.norm_squared());
+    let b2 = 0.5 * (rho0 * rho0 - rho2 * rho2 + a2.norm_squared());
+    let u = cross(&a1, &a2);
+    let uu = u.norm_squared();
+    if !uu.gt(&(1e-24 * a1.norm_squared() * a2.norm_squared())) || !uu.is_finite() {
+        return;
+    }
+    let y0 = (cross(&a2, &u) * b1 + cross(&u, &a1) * b2) / uu;
+    let y0n = y0.norm_squared();
+    let disc = rho0 * rho0 - y0n;
+    let eps = 64.0 * f64::EPSILON * (rho0 * rho0 + y0n);
+    if !disc.is_finite() || disc < -eps {
+        return;
+    }
+    if disc <= eps {
+        out.push(c0 + y0);
+        return;
+    }
+    let t = (disc / uu).sqrt();
+    out.push(c0 + y0 + u * t);
+    out.push(c0 + y0 - u * t);
+}
+
 /// A sort key of an [`Atom`] (ties of the nearest-element selection).
 fn atom_id(a: Atom) -> u64 {
     match a {
@@ -1062,10 +1117,16 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
             }
             failed_r[entry.1 as usize] = big_r;
             // Does the smallest grain of this orientation fit around P?
-            let small = scaled(&ms[0], params.radius_min / big_r);
-            let keep = std::env::var("NOSMALL").is_err() && small
-                .as_ref()
-                .is_some_and(|s| pk.around(entry.1, s).is_some());
+            // (Approximate wrappers skip the probe, which costs a full
+            // search, and drop P at its first failure once the front holds
+            // 32 grains.)
+            let keep = if pk.elems.is_some() && front.len() >= 32 {
+                false
+            } else {
+                scaled(&ms[0], params.radius_min / big_r)
+                    .as_ref()
+                    .is_some_and(|s| pk.around(entry.1, s).is_some())
+            };
             if !keep {
                 front.remove(&entry);
             }
@@ -1082,10 +1143,6 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
                 rejects_in_row += 1;
             }
         }
-    }
-    if std::env::var("DBG").is_ok() {
-        use std::sync::atomic::Ordering::Relaxed;
-        eprintln!("calls {} ok {} cands {} tried {} local {} rejected {rejected}", DBG_CALLS.load(Relaxed), DBG_OK.load(Relaxed), DBG_CANDS.load(Relaxed), DBG_TRIED.load(Relaxed), DBG_LOCAL.load(Relaxed));
     }
     Ok(PicPacking {
         grains: pk.grains,
