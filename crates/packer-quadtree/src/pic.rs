@@ -20,6 +20,11 @@
 //! 4. the packing ends when the front is empty, after 400 discards in a
 //!    row, or at [`PicParams::max_grains`].
 //!
+//! [`ContactMethod::ApproxWrappers`] (disk/sphere clusters only) replaces
+//! step 2's grain-level sets by element-level ones on a cell grid of every
+//! placed element and drops a front grain at its first failure once the
+//! front holds 32 grains (no smallest-grain probe); see its docs.
+//!
 //! Overlap tolerance: a candidate is accepted with every gap
 //! `≥ −1e-10·R_mob`; contacts are solved to `1e-13·R_mob` (closed forms
 //! and Newton) or `1e-10·R_mob` (Nelder–Mead).
@@ -142,7 +147,10 @@ impl PicParams {
     /// contacts; P2 4-disk clusters by the seed's wrappers, 8 orientations
     /// tried per grain; P3 exact capsules by Newton, 64 orientations; P4
     /// exact capsules by Newton, the drawn orientation only, 10 partners;
-    /// P5 4-sphere clusters by Newton, 10 partners.
+    /// P5 4-sphere clusters by the seed's approximate wrappers
+    /// ([`ContactMethod::ApproxWrappers`], 6 nearest elements per element
+    /// of the front grain; Newton with 10 partners packs 0.54 at ~220
+    /// grains/s, the approximate method ~0.38 at ~15 000 grains/s).
     ///
     /// # Errors
     /// [`Error::Parameter`] for an unknown row id.
@@ -196,7 +204,8 @@ impl PicParams {
                 Self {
                     side: 40.0,
                     shape: cluster,
-                    neighbours: 10,
+                    method: ContactMethod::ApproxWrappers,
+                    neighbours: 6,
                     ..base
                 },
             ),
@@ -767,11 +776,18 @@ impl<const D: usize> Packer<'_, D> {
         let mut near: Vec<(f64, Atom)> = Vec::new();
         let mut wraps: Vec<Wrap<D>> = Vec::new();
         let mut tmp = Vec::with_capacity(2);
+        // Possible partners of P's elements: within `R_P + 2s + r_max`.
+        let pr = self.grains[p as usize].grain.circumradius + 2.0 * s + el.rmax;
+        let close: Vec<(SVector<f64, D>, f64, u32)> = local
+            .iter()
+            .filter(|e| (e.0 - pc).norm_squared() <= pr * pr)
+            .copied()
+            .collect();
         for a in lo_e..hi_e {
             let ca = el.centre[a];
             let ra = el.radius[a];
             near.clear();
-            for &(c, r, q) in &local {
+            for &(c, r, q) in &close {
                 // Siblings before `a` already had their turn.
                 if (q as usize) <= a && (q as usize) >= lo_e {
                     continue;
@@ -827,7 +843,8 @@ impl<const D: usize> Packer<'_, D> {
                         continue;
                     }
                     for y in tmp.iter().filter(|y| clear(y)) {
-                        let mut n = (y - ca).normalize() + (y - self.atom_point(el, b, y)).normalize();
+                        let mut n =
+                            (y - ca).normalize() + (y - self.atom_point(el, b, y)).normalize();
                         if D == 3 {
                             n += (y - self.atom_point(el, c, y)).normalize();
                         }
@@ -894,7 +911,9 @@ impl<const D: usize> Packer<'_, D> {
     fn atom_wrap(&self, el: &Elements<D>, a: Atom, s: f64) -> Wrap<D> {
         match a {
             Atom::Elem(q) => Wrap::Sphere(el.centre[q as usize], el.radius[q as usize] + s),
-            Atom::Wall { axis, upper } => self.wrap(Obj::Wall { axis, upper }, 0.0, &SVector::zeros(), s),
+            Atom::Wall { axis, upper } => {
+                self.wrap(Obj::Wall { axis, upper }, 0.0, &SVector::zeros(), s)
+            }
         }
     }
 
@@ -907,7 +926,8 @@ impl<const D: usize> Packer<'_, D> {
                 (el.centre[i as usize] - el.centre[j as usize]).norm_squared() <= reach * reach
             }
             (Atom::Wall { axis: a1, .. }, Atom::Wall { axis: a2, .. }) => a1 != a2,
-            (Atom::Elem(i), Atom::Wall { axis, upper }) | (Atom::Wall { axis, upper }, Atom::Elem(i)) => {
+            (Atom::Elem(i), Atom::Wall { axis, upper })
+            | (Atom::Wall { axis, upper }, Atom::Elem(i)) => {
                 let c = el.centre[i as usize][axis];
                 let d = if upper { side - c } else { c };
                 d - el.radius[i as usize] <= 2.0 * s
