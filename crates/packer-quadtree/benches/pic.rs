@@ -1,7 +1,8 @@
 //! Particles per second of the Pérez Morales et al. 2016 rows
 //! (`PicParams::perezmorales2016`), seed 1: criterion's throughput is the
 //! placed grain count, so it reports grains/s directly. The seed's speeds:
-//! P2 1.05, P3 0.0094, P4 3.90, P5 172.30 particles/s.
+//! P2 1.05, P3 0.0094, P4 3.90, P5 172.30 particles/s. P5's preset uses
+//! the approximate wrappers; `P5-newton` times the exact clusters.
 //!
 //! `cargo bench -p packer-quadtree --bench pic` (P4/P5 take seconds per
 //! packing; `-- P2` selects one row).
@@ -28,6 +29,18 @@ fn rows(c: &mut Criterion) {
             dim,
             PicParams {
                 method: ContactMethod::NelderMead,
+                ..p
+            },
+        ));
+    }
+    // P5 with exact Newton clusters, for comparison.
+    if let Ok((dim, p)) = PicParams::perezmorales2016("P5") {
+        rows.push((
+            "P5-newton".to_owned(),
+            dim,
+            PicParams {
+                method: ContactMethod::Newton,
+                neighbours: 10,
                 ..p
             },
         ));

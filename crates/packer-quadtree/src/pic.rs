@@ -20,6 +20,11 @@
 //! 4. the packing ends when the front is empty, after 400 discards in a
 //!    row, or at [`PicParams::max_grains`].
 //!
+//! [`ContactMethod::ApproxWrappers`] (disk/sphere clusters only) replaces
+//! step 2's grain-level sets by element-level ones on a cell grid of every
+//! placed element and drops a front grain at its first failure once the
+//! front holds 32 grains (no smallest-grain probe); see its docs.
+//!
 //! Overlap tolerance: a candidate is accepted with every gap
 //! `≥ −1e-10·R_mob`; contacts are solved to `1e-13·R_mob` (closed forms
 //! and Newton) or `1e-10·R_mob` (Nelder–Mead).
@@ -50,6 +55,19 @@ pub enum ContactMethod {
     /// The seed's Nelder–Mead minimisation of the gaps (§3.2), from the
     /// same first guesses, for comparison.
     NelderMead,
+    /// The seed's "approximate wrappers method" (P5) for disks/spheres and
+    /// their clusters of equal elements: one element of the new cluster is
+    /// placed tangent to one element of the front grain and one (2D) or two
+    /// (3D) elements or walls among the nearest placed elements (closed
+    /// form), the cluster follows rigidly in its drawn orientation (each of
+    /// its elements is tried as the contact one), and candidates, lowest
+    /// first, are rejected by element–element overlap tests on a cell grid
+    /// of all placed elements. Approximate: the cluster touches one set of
+    /// elements, not the lowest exact contact of the whole cluster, so
+    /// packings are looser than [`ContactMethod::Newton`]'s, but two
+    /// orders of magnitude faster. Other shapes fall back to
+    /// [`ContactMethod::Newton`].
+    ApproxWrappers,
 }
 
 /// Parameters of a particle-in-contact packing.
@@ -129,7 +147,10 @@ impl PicParams {
     /// contacts; P2 4-disk clusters by the seed's wrappers, 8 orientations
     /// tried per grain; P3 exact capsules by Newton, 64 orientations; P4
     /// exact capsules by Newton, the drawn orientation only, 10 partners;
-    /// P5 4-sphere clusters by Newton, 10 partners.
+    /// P5 4-sphere clusters by the seed's approximate wrappers
+    /// ([`ContactMethod::ApproxWrappers`], 6 nearest elements per element
+    /// of the front grain; Newton with 10 partners packs 0.54 at ~220
+    /// grains/s, the approximate method ~0.38 at ~15 000 grains/s).
     ///
     /// # Errors
     /// [`Error::Parameter`] for an unknown row id.
@@ -183,7 +204,8 @@ impl PicParams {
                 Self {
                     side: 40.0,
                     shape: cluster,
-                    neighbours: 10,
+                    method: ContactMethod::ApproxWrappers,
+                    neighbours: 6,
                     ..base
                 },
             ),
@@ -310,6 +332,25 @@ struct Packer<'a, const D: usize> {
     rmax_placed: f64,
     tol_rel: f64,
     neighbours: usize,
+    /// Every placed element, for [`ContactMethod::ApproxWrappers`].
+    elems: Option<Elements<D>>,
+}
+
+/// The placed disks/spheres of every grain (approximate wrappers): centres,
+/// radii, the first element of each grain and a cell grid of them.
+struct Elements<const D: usize> {
+    centre: Vec<SVector<f64, D>>,
+    radius: Vec<f64>,
+    first: Vec<u32>,
+    grid: Grid<D>,
+    rmax: f64,
+}
+
+/// An element or a wall, contact partner of the approximate wrappers.
+#[derive(Debug, Clone, Copy)]
+enum Atom {
+    Elem(u32),
+    Wall { axis: usize, upper: bool },
 }
 
 impl<const D: usize> Packer<'_, D> {
@@ -555,6 +596,11 @@ impl<const D: usize> Packer<'_, D> {
     /// and refined in that order until a guess is higher than the best
     /// position found plus a margin (`0` for closed forms, `R_mob/2` else).
     fn around(&self, p: u32, m: &Grain<D>) -> Option<SVector<f64, D>> {
+        if let Some(el) = &self.elems
+            && m.is_sphere_cluster()
+        {
+            return self.around_approx(el, p, m);
+        }
         let pc = self.grains[p as usize].centre;
         let pr = self.grains[p as usize].grain.circumradius;
         let rm = m.circumradius;
@@ -656,11 +702,289 @@ impl<const D: usize> Packer<'_, D> {
         let id = self.grains.len() as u32;
         self.rmax_placed = self.rmax_placed.max(g.circumradius);
         self.grid.insert(&x, id);
+        if let (Some(el), Geometry::Swept(e)) = (self.elems.as_mut(), &g.geometry) {
+            el.first.push(el.centre.len() as u32);
+            for s in e {
+                let c = x + s.a;
+                let k = el.centre.len() as u32;
+                el.grid.insert(&c, k);
+                el.centre.push(c);
+                el.radius.push(s.radius);
+                el.rmax = el.rmax.max(s.radius);
+            }
+        }
         self.grains.push(Placed {
             centre: x,
             grain: g,
         });
         id
+    }
+}
+
+impl<const D: usize> Packer<'_, D> {
+    /// [`ContactMethod::ApproxWrappers`]: the lowest candidate position of
+    /// the cluster `m` (equal elements) around `P = grains[p]` that
+    /// overlaps no placed element and stays in the domain. For each element
+    /// `a` of `P`, its `neighbours` nearest placed elements (surface
+    /// distance) and the walls within reach are the partners; every pair
+    /// (3D) or single partner (2D) reachable together with `a` gives up to
+    /// two closed-form centres `y` of a mobile element tangent to all (kept
+    /// if it clears `a`'s partners), and the cluster is placed rigidly in
+    /// its drawn orientation with the element facing the partners (the
+    /// smallest offset along the sum of the contact normals) at `y`.
+    /// Candidates are tried lowest first against the placed elements near
+    /// `P`, the element that rejected the previous candidate first.
+    fn around_approx(&self, el: &Elements<D>, p: u32, m: &Grain<D>) -> Option<SVector<f64, D>> {
+        let Geometry::Swept(me) = &m.geometry else {
+            return None;
+        };
+        let s = me[0].radius;
+        let rm = m.circumradius;
+        let side = self.params.side;
+        let tol = self.tol_rel * rm;
+        let last = D - 1;
+        let lo_e = el.first[p as usize] as usize;
+        let hi_e = el
+            .first
+            .get(p as usize + 1)
+            .map_or(el.centre.len(), |&k| k as usize);
+        // Placed elements that may meet the cluster at any candidate (the
+        // candidates lie within `R_P + R_m` of P's centre) or be a partner.
+        let pc = self.grains[p as usize].centre;
+        let reach = self.grains[p as usize].grain.circumradius + 2.0 * rm + el.rmax;
+        let mut local: Vec<(SVector<f64, D>, f64, u32)> = Vec::new();
+        // Through the (coarser) grain grid, then each grain's elements.
+        self.grid.query(&pc, reach + self.rmax_placed, |g| {
+            let gp = &self.grains[g as usize];
+            let rg = reach + gp.grain.circumradius;
+            if (gp.centre - pc).norm_squared() > rg * rg {
+                return;
+            }
+            let lo = el.first[g as usize] as usize;
+            let hi = el
+                .first
+                .get(g as usize + 1)
+                .map_or(el.centre.len(), |&k| k as usize);
+            for q in lo..hi {
+                let c = el.centre[q];
+                if (c - pc).norm_squared() <= reach * reach {
+                    local.push((c, el.radius[q], q as u32));
+                }
+            }
+        });
+        let mut ys: Vec<(SVector<f64, D>, SVector<f64, D>)> = Vec::new();
+        let mut near: Vec<(f64, Atom)> = Vec::new();
+        let mut wraps: Vec<Wrap<D>> = Vec::new();
+        let mut tmp = Vec::with_capacity(2);
+        // Possible partners of P's elements: within `R_P + 2s + r_max`.
+        let pr = self.grains[p as usize].grain.circumradius + 2.0 * s + el.rmax;
+        let close: Vec<(SVector<f64, D>, f64, u32)> = local
+            .iter()
+            .filter(|e| (e.0 - pc).norm_squared() <= pr * pr)
+            .copied()
+            .collect();
+        for a in lo_e..hi_e {
+            let ca = el.centre[a];
+            let ra = el.radius[a];
+            near.clear();
+            for &(c, r, q) in &close {
+                // Siblings before `a` already had their turn.
+                if (q as usize) <= a && (q as usize) >= lo_e {
+                    continue;
+                }
+                let d2 = (c - ca).norm_squared();
+                let lim = r + ra + 2.0 * s;
+                if d2 <= lim * lim {
+                    near.push((d2.sqrt() - r - ra, Atom::Elem(q)));
+                }
+            }
+            if near.len() > self.neighbours {
+                near.select_nth_unstable_by(self.neighbours, |x, y| {
+                    x.0.total_cmp(&y.0).then(atom_id(x.1).cmp(&atom_id(y.1)))
+                });
+                near.truncate(self.neighbours);
+            }
+            for axis in 0..D {
+                for upper in [false, true] {
+                    let d = if upper { side - ca[axis] } else { ca[axis] } - ra;
+                    if d <= 2.0 * s {
+                        near.push((d, Atom::Wall { axis, upper }));
+                    }
+                }
+            }
+            wraps.clear();
+            wraps.extend(near.iter().map(|&(_, b)| self.atom_wrap(el, b, s)));
+            let clear = |y: &SVector<f64, D>| {
+                near.iter().all(|&(_, q)| match q {
+                    Atom::Elem(q) => {
+                        let min = el.radius[q as usize] + s - tol;
+                        (el.centre[q as usize] - y).norm_squared() >= min * min
+                    }
+                    Atom::Wall { .. } => true,
+                })
+            };
+            let wa = Wrap::Sphere(ca, ra + s);
+            for (i, &(_, b)) in near.iter().enumerate() {
+                let pairs = if D == 2 { i..i + 1 } else { i + 1..near.len() };
+                for k in pairs {
+                    let c = near[k].1;
+                    if D == 2 {
+                        intersect(&[wa, wraps[i]], &mut tmp);
+                    } else if let (Wrap::Sphere(c1, r1), Wrap::Sphere(c2, r2)) =
+                        (wraps[i], wraps[k])
+                    {
+                        if (c1 - c2).norm_squared() > (r1 + r2) * (r1 + r2) {
+                            continue;
+                        }
+                        tangent3(&ca, ra + s, &c1, r1, &c2, r2, &mut tmp);
+                    } else if self.atoms_reach(el, b, c, s) {
+                        intersect(&[wa, wraps[i], wraps[k]], &mut tmp);
+                    } else {
+                        continue;
+                    }
+                    for y in tmp.iter().filter(|y| clear(y)) {
+                        let mut n =
+                            (y - ca).normalize() + (y - self.atom_point(el, b, y)).normalize();
+                        if D == 3 {
+                            n += (y - self.atom_point(el, c, y)).normalize();
+                        }
+                        ys.push((*y, n));
+                    }
+                }
+            }
+        }
+        // The cluster with its element facing the partners at each centre.
+        let mut cands: Vec<(f64, SVector<f64, D>)> = Vec::with_capacity(ys.len());
+        for &(y, n) in &ys {
+            let mut j = 0;
+            let mut best = f64::INFINITY;
+            for (k, e) in me.iter().enumerate() {
+                let v = e.a.dot(&n);
+                if v < best {
+                    best = v;
+                    j = k;
+                }
+            }
+            let x = y - me[j].a;
+            if (0..D).all(|i| x[i] + m.lo[i] >= -tol && x[i] + m.hi[i] <= side + tol) {
+                cands.push((x[last], x));
+            }
+        }
+        cands.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let mut culprit = 0usize;
+        'cand: for (_, x) in cands {
+            for k in std::iter::once(culprit).chain(0..local.len()) {
+                let Some(&(c, r, _)) = local.get(k) else {
+                    continue;
+                };
+                let rel = c - x;
+                let big = rm + r;
+                if rel.norm_squared() >= big * big {
+                    continue;
+                }
+                for e in me {
+                    let min = r + e.radius - tol;
+                    if (rel - e.a).norm_squared() < min * min {
+                        culprit = k;
+                        continue 'cand;
+                    }
+                }
+            }
+            return Some(x);
+        }
+        None
+    }
+
+    /// Centre of element `a`, or the foot of `y` on wall `a`.
+    fn atom_point(&self, el: &Elements<D>, a: Atom, y: &SVector<f64, D>) -> SVector<f64, D> {
+        match a {
+            Atom::Elem(q) => el.centre[q as usize],
+            Atom::Wall { axis, upper } => {
+                let mut f = *y;
+                f[axis] = if upper { self.params.side } else { 0.0 };
+                f
+            }
+        }
+    }
+
+    /// Wrapper of an element or wall for a mobile element of radius `s`.
+    fn atom_wrap(&self, el: &Elements<D>, a: Atom, s: f64) -> Wrap<D> {
+        match a {
+            Atom::Elem(q) => Wrap::Sphere(el.centre[q as usize], el.radius[q as usize] + s),
+            Atom::Wall { axis, upper } => {
+                self.wrap(Obj::Wall { axis, upper }, 0.0, &SVector::zeros(), s)
+            }
+        }
+    }
+
+    /// Whether one mobile element of radius `s` can touch both `a` and `b`.
+    fn atoms_reach(&self, el: &Elements<D>, a: Atom, b: Atom, s: f64) -> bool {
+        let side = self.params.side;
+        match (a, b) {
+            (Atom::Elem(i), Atom::Elem(j)) => {
+                let reach = el.radius[i as usize] + el.radius[j as usize] + 2.0 * s;
+                (el.centre[i as usize] - el.centre[j as usize]).norm_squared() <= reach * reach
+            }
+            (Atom::Wall { axis: a1, .. }, Atom::Wall { axis: a2, .. }) => a1 != a2,
+            (Atom::Elem(i), Atom::Wall { axis, upper })
+            | (Atom::Wall { axis, upper }, Atom::Elem(i)) => {
+                let c = el.centre[i as usize][axis];
+                let d = if upper { side - c } else { c };
+                d - el.radius[i as usize] <= 2.0 * s
+            }
+        }
+    }
+}
+
+/// Centres `x` with `|x − c_i| = ρ_i` for three spheres (3D only; the
+/// closed form of [`contact3d::intersect`] without its conversions): none
+/// for collinear centres or no intersection, one when tangent.
+fn tangent3<const D: usize>(
+    c0: &SVector<f64, D>,
+    rho0: f64,
+    c1: &SVector<f64, D>,
+    rho1: f64,
+    c2: &SVector<f64, D>,
+    rho2: f64,
+    out: &mut Vec<SVector<f64, D>>,
+) {
+    out.clear();
+    let cross = |a: &SVector<f64, D>, b: &SVector<f64, D>| {
+        SVector::<f64, D>::from_fn(|i, _| {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            a[j] * b[k] - a[k] * b[j]
+        })
+    };
+    let a1 = c1 - c0;
+    let a2 = c2 - c0;
+    let b1 = 0.5 * (rho0 * rho0 - rho1 * rho1 + a1.norm_squared());
+    let b2 = 0.5 * (rho0 * rho0 - rho2 * rho2 + a2.norm_squared());
+    let u = cross(&a1, &a2);
+    let uu = u.norm_squared();
+    if !uu.gt(&(1e-24 * a1.norm_squared() * a2.norm_squared())) || !uu.is_finite() {
+        return;
+    }
+    let y0 = (cross(&a2, &u) * b1 + cross(&u, &a1) * b2) / uu;
+    let y0n = y0.norm_squared();
+    let disc = rho0 * rho0 - y0n;
+    let eps = 64.0 * f64::EPSILON * (rho0 * rho0 + y0n);
+    if !disc.is_finite() || disc < -eps {
+        return;
+    }
+    if disc <= eps {
+        out.push(c0 + y0);
+        return;
+    }
+    let t = (disc / uu).sqrt();
+    out.push(c0 + y0 + u * t);
+    out.push(c0 + y0 - u * t);
+}
+
+/// A sort key of an [`Atom`] (ties of the nearest-element selection).
+fn atom_id(a: Atom) -> u64 {
+    match a {
+        Atom::Elem(q) => u64::from(q),
+        Atom::Wall { axis, upper } => u64::MAX - 2 * axis as u64 - u64::from(upper),
     }
 }
 
@@ -733,7 +1057,22 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
         rmax_placed: 0.0,
         tol_rel: 1e-10,
         neighbours: params.neighbours,
+        elems: None,
     };
+    if params.method == ContactMethod::ApproxWrappers {
+        let elem_max = match params.shape {
+            GrainShape::Ball => Some(params.radius_max),
+            GrainShape::Cluster { aspect, .. } => Some(aspect * params.radius_max),
+            _ => None,
+        };
+        pk.elems = elem_max.map(|r| Elements {
+            centre: Vec::new(),
+            radius: Vec::new(),
+            first: Vec::new(),
+            grid: Grid::new(params.side, 2.0 * r),
+            rmax: 0.0,
+        });
+    }
     // Grain `i`: its size, then `orientations` orientations of it, all
     // from the stream (seed, i).
     let draw = |i: u64| -> Result<Vec<Grain<D>>> {
@@ -798,10 +1137,16 @@ pub fn pack_pic<const D: usize>(params: &PicParams, seed: u64) -> Result<PicPack
             }
             failed_r[entry.1 as usize] = big_r;
             // Does the smallest grain of this orientation fit around P?
-            let small = scaled(&ms[0], params.radius_min / big_r);
-            let keep = small
-                .as_ref()
-                .is_some_and(|s| pk.around(entry.1, s).is_some());
+            // (Approximate wrappers skip the probe, which costs a full
+            // search, and drop P at its first failure once the front holds
+            // 32 grains.)
+            let keep = if pk.elems.is_some() && front.len() >= 32 {
+                false
+            } else {
+                scaled(&ms[0], params.radius_min / big_r)
+                    .as_ref()
+                    .is_some_and(|s| pk.around(entry.1, s).is_some())
+            };
             if !keep {
                 front.remove(&entry);
             }

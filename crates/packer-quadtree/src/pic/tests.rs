@@ -63,6 +63,7 @@ fn every_shape_packs_without_overlap() {
             ContactMethod::Wrappers,
             ContactMethod::Newton,
             ContactMethod::NelderMead,
+            ContactMethod::ApproxWrappers,
         ] {
             let params = PicParams {
                 method,
@@ -90,6 +91,67 @@ fn every_shape_packs_without_overlap() {
         assert!(rep.min_relative_gap >= -1e-9, "3D {shape:?}: {rep:?}");
         assert!(rep.min_relative_wall_gap >= -1e-9, "3D {shape:?}: {rep:?}");
     }
+}
+
+/// Approximate wrappers (P5's method) in 3D, spheres and 4-sphere
+/// clusters over three seeds: no overlap by the parry checker, a loose but
+/// real packing, and the tangent contacts it builds.
+#[test]
+fn approx_wrappers_pack_clusters_without_overlap_3d() {
+    for shape in [
+        GrainShape::Ball,
+        GrainShape::Cluster {
+            aspect: 0.5,
+            spheres: 4,
+        },
+    ] {
+        for seed in 1..=3 {
+            let params = PicParams {
+                method: ContactMethod::ApproxWrappers,
+                neighbours: 6,
+                ..small(shape, 12.0)
+            };
+            let p = pack_pic::<3>(&params, seed).expect("pack 3D");
+            let rep = check_pic(&p, 1e-9).expect("check");
+            assert!(p.grains.len() > 20, "{shape:?} {seed}: {}", p.grains.len());
+            assert!(p.fraction() > 0.2, "{shape:?} {seed}: {}", p.fraction());
+            assert!(rep.min_relative_gap >= -1e-9, "{shape:?} {seed}: {rep:?}");
+            assert!(
+                rep.min_relative_wall_gap >= -1e-9,
+                "{shape:?} {seed}: {rep:?}"
+            );
+            assert!(rep.coordination > 2.0, "{shape:?} {seed}: {rep:?}");
+        }
+    }
+}
+
+/// The closed-form three-sphere tangency agrees with `contact3d`.
+#[test]
+fn tangent3_matches_contact3d() {
+    let c = [
+        SVector::<f64, 3>::new(0.0, 0.0, 0.0),
+        SVector::<f64, 3>::new(2.0, 0.1, 0.0),
+        SVector::<f64, 3>::new(0.9, 1.8, 0.2),
+    ];
+    let rho = [1.7, 1.5, 1.6];
+    let mut out = Vec::new();
+    tangent3(&c[0], rho[0], &c[1], rho[1], &c[2], rho[2], &mut out);
+    assert_eq!(out.len(), 2);
+    for x in &out {
+        for k in 0..3 {
+            assert!(((x - c[k]).norm() - rho[k]).abs() < 1e-12);
+        }
+    }
+    let w = [0, 1, 2].map(|k| Wrapper3::Sphere {
+        centre: Point3::from(c[k]),
+        radius: rho[k],
+    });
+    let s = contact3d::intersect(&w);
+    assert_eq!(s.iter().count(), 2);
+    // Collinear centres: none.
+    let col = SVector::<f64, 3>::new(4.0, 0.2, 0.0);
+    tangent3(&c[0], 1.0, &c[1], 1.0, &col, 1.0, &mut out);
+    assert!(out.is_empty());
 }
 
 #[test]
