@@ -60,59 +60,23 @@ struct Geom {
     w_over_t: f64,
 }
 
+/// NIST's rows of both embedded Ottawa tables (`validate::grains`).
 fn geom_table() -> anyhow::Result<Vec<(String, Geom)>> {
     let mut out = Vec::new();
     for t in validate::grains::GEOM_TABLES {
-        out.extend(geom_table_of(t)?);
-    }
-    Ok(out)
-}
-
-fn geom_table_of(name: &str) -> anyhow::Result<Vec<(String, Geom)>> {
-    let text = validate::fixtures::grain(name)?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .context("empty geom table")?
-        .split_whitespace()
-        .collect();
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .with_context(|| format!("geom table lacks {name}"))
-    };
-    let (iv, ia, inorm, innn, ilt, iwt) = (
-        col("volume")?,
-        col("surf._area")?,
-        col("norm_surf_area")?,
-        col("Nnn")?,
-        col("L/T")?,
-        col("W/T")?,
-    );
-    let mut out = Vec::new();
-    for (n, line) in lines.enumerate() {
-        if line.trim().is_empty() {
-            continue;
+        for r in validate::grains::geom_table(t)? {
+            out.push((
+                r.file,
+                Geom {
+                    volume: r.volume,
+                    area: r.area,
+                    norm_surf_area: r.normalised_area,
+                    nnn: r.nnn,
+                    l_over_t: r.lt_wt[0],
+                    w_over_t: r.lt_wt[1],
+                },
+            ));
         }
-        let f: Vec<&str> = line.split('\t').map(str::trim).collect();
-        let num = |i: usize| -> anyhow::Result<f64> {
-            f.get(i)
-                .with_context(|| format!("geom table line {}: missing field {i}", n + 2))?
-                .parse::<f64>()
-                .with_context(|| format!("geom table line {}: field {i}", n + 2))
-        };
-        out.push((
-            f[0].to_owned(),
-            Geom {
-                volume: num(iv)?,
-                area: num(ia)?,
-                norm_surf_area: num(inorm)?,
-                nnn: num(innn)? as usize,
-                l_over_t: num(ilt)?,
-                w_over_t: num(iwt)?,
-            },
-        ));
     }
     Ok(out)
 }

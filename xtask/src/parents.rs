@@ -312,7 +312,6 @@ pub(crate) fn load(args: &ParentArgs, source: &Path) -> anyhow::Result<Loaded> {
             source.display()
         );
     }
-    let read_start = Instant::now();
     let mut out = match format {
         InputFormat::Stl | InputFormat::Obj => load_meshes(args, &files, format)?,
         InputFormat::Anm => load_sh(args, &files)?,
@@ -320,10 +319,6 @@ pub(crate) fn load(args: &ParentArgs, source: &Path) -> anyhow::Result<Loaded> {
         _ => unreachable!("images are handled above"),
     };
     out.ignored = ignored;
-    out.files = files.len();
-    if out.read_s == 0.0 {
-        out.read_s = read_start.elapsed().as_secs_f64();
-    }
     check_count(&out, source)?;
     Ok(out)
 }

@@ -55,6 +55,16 @@ pub fn grain(name: &str) -> Result<&'static str, Error> {
     find(index::GRAINS, name)
 }
 
+/// Contents of `fixtures/calibrated/<name>` (e.g. `gsc2-ottawa.ron`).
+///
+/// # Errors
+/// [`Error::MissingFixture`] if no such file is embedded.
+pub fn calibrated(name: &str) -> Result<&'static str, Error> {
+    find(index::CALIBRATED, name).map_err(|_| Error::MissingFixture {
+        name: format!("calibrated/{name}"),
+    })
+}
+
 /// The grain files under `fixtures/grains/<folder>/` whose name ends with
 /// `suffix` (e.g. `grains_in("vcctl/ottawa", ".dat")`), sorted by name.
 #[must_use]

@@ -47,6 +47,8 @@ pub struct GeomRow {
     pub nnn: usize,
     /// Length, width, thickness (table units).
     pub ltw: [f64; 3],
+    /// NIST's printed L/T and W/T.
+    pub lt_wt: [f64; 2],
 }
 
 /// The rows of one NIST geometry table, in file order.
@@ -74,6 +76,8 @@ pub fn geom_table(name: &str) -> Result<Vec<GeomRow>, Error> {
         col("length(mm)")?,
         col("width(mm)")?,
         col("thick(mm)")?,
+        col("L/T")?,
+        col("W/T")?,
     ];
     let names = [
         "volume",
@@ -83,6 +87,8 @@ pub fn geom_table(name: &str) -> Result<Vec<GeomRow>, Error> {
         "length(mm)",
         "width(mm)",
         "thick(mm)",
+        "L/T",
+        "W/T",
     ];
     let mut out = Vec::new();
     for (n, line) in lines.enumerate() {
@@ -90,7 +96,7 @@ pub fn geom_table(name: &str) -> Result<Vec<GeomRow>, Error> {
             continue;
         }
         let f: Vec<&str> = line.split_whitespace().collect();
-        let mut v = [0.0; 7];
+        let mut v = [0.0; 9];
         for (k, (&c, cname)) in cols.iter().zip(names).enumerate() {
             let cell = f.get(c).copied().unwrap_or("");
             v[k] = cell.parse().map_err(|_| Error::NotANumber {
@@ -107,6 +113,7 @@ pub fn geom_table(name: &str) -> Result<Vec<GeomRow>, Error> {
             normalised_area: v[2],
             nnn: v[3] as usize,
             ltw: [v[4], v[5], v[6]],
+            lt_wt: [v[7], v[8]],
         });
     }
     Ok(out)

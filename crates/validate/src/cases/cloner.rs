@@ -31,19 +31,23 @@ fn err(e: impl std::fmt::Display) -> Error {
     }
 }
 
-fn calibrated() -> Result<Vec<Check>, Error> {
-    let text = fixtures::calibrated_files()
-        .iter()
-        .find(|(n, _)| *n == CALIBRATED)
-        .map(|(_, t)| *t)
-        .ok_or_else(|| Error::MissingFixture {
-            name: format!("calibrated/{CALIBRATED}"),
-        })?;
-    let cal = Calibrated::from_ron(text).map_err(err)?;
-    let parents = crate::grains::ottawa_parents()?;
-    let model = CloneModel::fit(&parents, &cal.params).map_err(err)?;
+/// Re-runs the committed calibration `fixtures/calibrated/<name>` on
+/// `parents`: the configuration, its scores, and the run's accepted clones
+/// and candidates drawn.
+pub(crate) fn rerun_calibration(
+    name: &str,
+    parents: &cloner::Parents,
+) -> Result<(Calibrated, cloner::Scores, usize, u64), Error> {
+    let cal = Calibrated::from_ron(fixtures::calibrated(name)?).map_err(err)?;
+    let model = CloneModel::fit(parents, &cal.params).map_err(err)?;
     let run = model.run(0..cal.clones, Hooks::default()).map_err(err)?;
     let s = score(parents.dna(), &run.dna_table().map_err(err)?).map_err(err)?;
+    Ok((cal, s, run.clones.len(), run.stats.attempts))
+}
+
+fn calibrated() -> Result<Vec<Check>, Error> {
+    let parents = crate::grains::ottawa_parents()?;
+    let (cal, s, clones, attempts) = rerun_calibration(CALIBRATED, &parents)?;
     let t4 = Table::reference("gsc2018_table4_mean_error_pct.csv")?;
     let t5 = Table::reference("gsc2018_table5_std_error_pct.csv")?;
     let mut out = Vec::new();
@@ -94,7 +98,7 @@ fn calibrated() -> Result<Vec<Check>, Error> {
     out.push(Check::new(
         "clones >= 500",
         500.0,
-        run.clones.len() as f64,
+        clones as f64,
         Tolerance::AtLeast(0.0),
     ));
     out.push(Check::new(
@@ -106,7 +110,7 @@ fn calibrated() -> Result<Vec<Check>, Error> {
     out.push(Check::new(
         "candidates drawn reproduce the committed calibration",
         cal.attempts as f64,
-        run.stats.attempts as f64,
+        attempts as f64,
         Tolerance::Within(0.0),
     ));
     Ok(out)

@@ -265,13 +265,7 @@ fn roundtrip_clones() -> Result<&'static GridsAndDna, Error> {
     CLONES
         .get_or_init(|| {
             let run = || -> Result<GridsAndDna, Error> {
-                let text = crate::fixtures::calibrated_files()
-                    .iter()
-                    .find(|(n, _)| *n == "gsc2-ottawa.ron")
-                    .map(|(_, t)| *t)
-                    .ok_or_else(|| Error::MissingFixture {
-                        name: "calibrated/gsc2-ottawa.ron".into(),
-                    })?;
+                let text = crate::fixtures::calibrated("gsc2-ottawa.ron")?;
                 let cal = cloner::Calibrated::from_ron(text).map_err(err)?;
                 let mut params = cal.params;
                 params.outputs = cloner::Outputs {
@@ -464,20 +458,8 @@ fn roundtrip_stl() -> Result<Vec<Check>, Error> {
 /// file path builds them (45³ level sets of each file's own degree).
 fn ma107_calibrated() -> Result<Vec<Check>, Error> {
     let name = "gsc2-ma107-6.ron";
-    let text = crate::fixtures::calibrated_files()
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, t)| *t)
-        .ok_or_else(|| Error::MissingFixture {
-            name: format!("calibrated/{name}"),
-        })?;
-    let cal = cloner::Calibrated::from_ron(text).map_err(err)?;
     let parents = grains::vcctl_parents("vcctl/MA107-6-fine")?;
-    let model = cloner::CloneModel::fit(&parents, &cal.params).map_err(err)?;
-    let run = model
-        .run(0..cal.clones, cloner::Hooks::default())
-        .map_err(err)?;
-    let s = cloner::score(parents.dna(), &run.dna_table().map_err(err)?).map_err(err)?;
+    let (cal, s, clones, attempts) = super::cloner::rerun_calibration(name, &parents)?;
     let mut out = Vec::new();
     for (k, d) in cloner::TABLES_4_5.iter().enumerate() {
         out.push(Check::new(
@@ -509,7 +491,7 @@ fn ma107_calibrated() -> Result<Vec<Check>, Error> {
         Check::new(
             "clones >= 500",
             500.0,
-            run.clones.len() as f64,
+            clones as f64,
             Tolerance::AtLeast(0.0),
         ),
         Check::new(
@@ -521,7 +503,7 @@ fn ma107_calibrated() -> Result<Vec<Check>, Error> {
         Check::new(
             "candidates drawn reproduce the committed calibration",
             cal.attempts as f64,
-            run.stats.attempts as f64,
+            attempts as f64,
             Tolerance::Within(0.0),
         ),
     ]);
