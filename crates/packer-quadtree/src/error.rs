@@ -133,6 +133,10 @@ pub enum Error {
         /// What is empty.
         what: &'static str,
     },
+    /// A container mesh that cannot be used (open, non-manifold,
+    /// inconsistently oriented, degenerate), as levelset reports it.
+    #[error("container mesh: {0}")]
+    Mesh(#[from] levelset::Error),
     /// An I/O error from a writer.
     #[error("writing output failed: {0}")]
     Io(#[from] std::io::Error),

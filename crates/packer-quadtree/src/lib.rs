@@ -79,6 +79,7 @@ mod grading;
 mod index;
 mod io;
 mod metrics;
+mod pack3d;
 mod packer;
 mod pic;
 mod shapes;
@@ -92,6 +93,7 @@ pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};
 pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };
+pub use pack3d::{Container, MeshContainer, Sphere};
 pub use packer::{
     BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,
     pack_sizes, pack_sizes_with_index, pack_with_index,
