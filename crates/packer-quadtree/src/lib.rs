@@ -93,7 +93,10 @@ pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};
 pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };
-pub use pack3d::{Container, MeshContainer, Sphere};
+pub use pack3d::{
+    Container, MeshContainer, Pack3Params, Pack3Stats, Packing3, Sphere, pack3d, pack3d_seeded,
+    pack3d_sizes,
+};
 pub use packer::{
     BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,
     pack_sizes, pack_sizes_with_index, pack_with_index,

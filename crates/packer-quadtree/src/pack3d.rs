@@ -18,3 +18,237 @@ pub struct Sphere {
     /// Radius.
     pub radius: f64,
 }
+
+mod front;
+mod grid;
+
+pub use front::Pack3Stats;
+
+use crate::error::{Error, Result};
+use crate::grading::Grading;
+use crate::packer::FrontOrder;
+use rand::Rng;
+use rayon::prelude::*;
+
+/// Parameters of the 3D packer (plain data with `Default`, validated at
+/// entry).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pack3Params {
+    /// Front order; [`FrontOrder::Best`] runs the three orders on the same
+    /// sizes (in parallel) and keeps the densest packing.
+    pub front_order: FrontOrder,
+    /// A site takes the oldest of the next `lookahead` sizes that fits it
+    /// (`1`: sizes strictly in draw order, as the seed's size list).
+    pub lookahead: usize,
+    /// Upper bound on the number of spheres (guards against a unit mistake
+    /// exhausting memory; checked against the estimate before any work).
+    pub max_particles: usize,
+}
+
+impl Default for Pack3Params {
+    fn default() -> Self {
+        Self {
+            front_order: FrontOrder::LowestCandidate,
+            lookahead: 8,
+            max_particles: 50_000_000,
+        }
+    }
+}
+
+impl Pack3Params {
+    /// The densest configuration: the portfolio of front orders.
+    pub fn dense() -> Self {
+        Self {
+            front_order: FrontOrder::Best,
+            ..Self::default()
+        }
+    }
+
+    /// Checks the parameters.
+    ///
+    /// # Errors
+    /// [`Error::Parameter`] for a zero particle limit.
+    pub fn validate(&self) -> Result<()> {
+        if self.max_particles == 0 {
+            return Err(Error::Parameter {
+                what: "max_particles",
+                value: 0.0,
+                range: "[1, inf)",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A 3D packing.
+#[derive(Debug, Clone)]
+pub struct Packing3 {
+    /// Placed spheres, in placement order.
+    pub spheres: Vec<Sphere>,
+    /// The front order that produced it (the winner of the portfolio).
+    pub front_order: FrontOrder,
+    /// Run counters.
+    pub stats: Pack3Stats,
+}
+
+/// Mean sphere volume `π/6 · E[d³]` of a grading (by number), by the
+/// midpoint rule on 4096 quantiles.
+fn mean_volume(grading: &Grading) -> f64 {
+    let n = 4096;
+    let s: f64 = (0..n)
+        .map(|i| grading.diameter_at((i as f64 + 0.5) / n as f64).powi(3))
+        .sum();
+    std::f64::consts::PI / 6.0 * s / n as f64
+}
+
+/// Packs `container` with spheres whose diameters follow `grading` (by
+/// number), drawn by inverse-transform sampling from `rng` and used in
+/// draw order.
+///
+/// # Errors
+/// Validation errors of the container, grading and parameters;
+/// [`Error::DomainTooSmall`] when the container cannot hold one sphere of
+/// the largest size; [`Error::TooManyParticles`] when the count estimate
+/// (a solid fraction of 0.94 of the container in spheres of the mean
+/// volume) exceeds `params.max_particles`.
+pub fn pack3d(
+    container: &Container,
+    grading: &Grading,
+    params: &Pack3Params,
+    rng: &mut impl Rng,
+) -> Result<Packing3> {
+    container.validate()?;
+    grading.validate()?;
+    params.validate()?;
+    let (d_min, d_max) = (grading.d_min(), grading.d_max());
+    let inscribed = container.inscribed_diameter();
+    if inscribed < d_max {
+        return Err(Error::DomainTooSmall {
+            domain: inscribed,
+            particle: d_max,
+        });
+    }
+    if let Container::Box { min, max, periodic } = container {
+        for k in 0..2 {
+            if periodic[k] && max[k] - min[k] < 4.0 * d_max {
+                return Err(Error::DomainTooSmall {
+                    domain: max[k] - min[k],
+                    particle: 4.0 * d_max,
+                });
+            }
+        }
+    }
+    let est = (0.75 * 1.25 * container.volume() / mean_volume(grading)).ceil() + 64.0;
+    if !(est <= params.max_particles as f64) {
+        return Err(Error::TooManyParticles {
+            estimate: est,
+            limit: params.max_particles,
+        });
+    }
+    let sizes: Vec<f64> = (0..est as usize).map(|_| grading.sample(rng)).collect();
+    pack3d_sizes(container, &sizes, d_min, d_max, params)
+}
+
+/// [`pack3d`] with a ChaCha8 generator seeded by `seed`.
+///
+/// # Errors
+/// As [`pack3d`].
+pub fn pack3d_seeded(
+    container: &Container,
+    grading: &Grading,
+    params: &Pack3Params,
+    seed: u64,
+) -> Result<Packing3> {
+    use rand::SeedableRng;
+    pack3d(
+        container,
+        grading,
+        params,
+        &mut rand_chacha::ChaCha8Rng::seed_from_u64(seed),
+    )
+}
+
+/// Packs with the given diameters, used in order (`d_min`, `d_max`: the
+/// grading's bounds; `d_min` is the size tried before a front is removed).
+///
+/// # Errors
+/// As [`pack3d`], plus [`Error::Empty`] for no sizes and
+/// [`Error::NonPositive`] / [`Error::NonFinite`] for a bad size.
+pub fn pack3d_sizes(
+    container: &Container,
+    sizes: &[f64],
+    d_min: f64,
+    d_max: f64,
+    params: &Pack3Params,
+) -> Result<Packing3> {
+    container.validate()?;
+    params.validate()?;
+    if sizes.is_empty() {
+        return Err(Error::Empty { what: "size list" });
+    }
+    let mut lo = crate::error::positive("d_min", d_min)?;
+    let mut hi = crate::error::positive("d_max", d_max)?;
+    for &d in sizes {
+        crate::error::positive("sphere diameter", d)?;
+        lo = lo.min(d);
+        hi = hi.max(d);
+    }
+    if params.max_particles < sizes.len().min(params.max_particles) {
+        return Err(Error::TooManyParticles {
+            estimate: sizes.len() as f64,
+            limit: params.max_particles,
+        });
+    }
+    let inscribed = container.inscribed_diameter();
+    if inscribed < hi {
+        return Err(Error::DomainTooSmall {
+            domain: inscribed,
+            particle: hi,
+        });
+    }
+    let orders: Vec<FrontOrder> = if params.front_order == FrontOrder::Best {
+        vec![
+            FrontOrder::LowestCandidate,
+            FrontOrder::Stack,
+            FrontOrder::LowestFirst,
+        ]
+    } else {
+        vec![params.front_order]
+    };
+    let runs: Vec<Packing3> = orders
+        .par_iter()
+        .map(|&order| {
+            let mut f = front::Front3::new(container, 0.5 * lo, 0.5 * hi, sizes.len());
+            let mut next = |k: usize| sizes.get(k).copied();
+            f.run(order, &mut next, params.max_particles, params.lookahead);
+            let stats = f.stats;
+            Packing3 {
+                spheres: f
+                    .xs
+                    .iter()
+                    .map(|q| Sphere {
+                        center: Point3::new(q[0], q[1], q[2]),
+                        radius: q[3],
+                    })
+                    .collect(),
+                front_order: order,
+                stats,
+            }
+        })
+        .collect();
+    // Densest run; ties keep the earlier order.
+    let mut best: Option<(f64, Packing3)> = None;
+    for p in runs {
+        let v: f64 = p.spheres.iter().map(|s| s.radius.powi(3)).sum();
+        if best.as_ref().is_none_or(|(b, _)| v > *b) {
+            best = Some((v, p));
+        }
+    }
+    match best {
+        Some((_, p)) if !p.spheres.is_empty() => Ok(p),
+        _ => Err(Error::DomainTooSmall {
+            domain: inscribed,
+            particle: sizes[0],
+        }),
+    }
+}

@@ -1,0 +1,55 @@
+//! Probe of the 3D packer: density (centre-in-core estimate) and time.
+//! `cargo run --release --example pack3d_probe -- SIDE ORDER [mono]`
+#![allow(clippy::print_stdout)]
+use nalgebra::{Point3, Vector3};
+use packer_quadtree::{Container, FrontOrder, Grading, Pack3Params, pack3d_seeded};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let side: f64 = args.get(1).map_or(Ok(80.0), |s| s.parse())?;
+    let order = match args.get(2).map_or("lc", String::as_str) {
+        "stack" => FrontOrder::Stack,
+        "lf" => FrontOrder::LowestFirst,
+        "best" => FrontOrder::Best,
+        _ => FrontOrder::LowestCandidate,
+    };
+    let mono = args.get(3).is_some_and(|s| s == "mono");
+    let grading = if mono {
+        Grading::Constant { diameter: 1.0 }
+    } else {
+        Grading::Uniform { min: 1.0, max: 2.0 }
+    };
+    let dmax = grading.d_max();
+    let c = Container::walled_box(Vector3::new(side, side, side));
+    let params = Pack3Params {
+        lookahead: std::env::var("LA").ok().and_then(|s| s.parse().ok()).unwrap_or(8),
+        front_order: order,
+        ..Pack3Params::default()
+    };
+    let t = std::time::Instant::now();
+    let p = pack3d_seeded(&c, &grading, &params, 1)?;
+    let el = t.elapsed().as_secs_f64();
+    let m = 2.0 * dmax;
+    let lo = Point3::new(m, m, m);
+    let hi = Point3::new(side - m, side - m, side - m);
+    let mut v = 0.0;
+    let mut tot = 0.0;
+    for s in &p.spheres {
+        let vol = std::f64::consts::PI * 4.0 / 3.0 * s.radius.powi(3);
+        tot += vol;
+        if (0..3).all(|k| s.center[k] >= lo[k] && s.center[k] <= hi[k]) {
+            v += vol;
+        }
+    }
+    let core = (side - 2.0 * m).powi(3);
+    println!(
+        "n {} time {:.3}s  overall {:.4} core(centre) {:.4} order {:?} stats {:?}",
+        p.spheres.len(),
+        el,
+        tot / c.volume(),
+        v / core,
+        p.front_order,
+        p.stats
+    );
+    Ok(())
+}
