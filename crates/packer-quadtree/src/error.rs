@@ -2,7 +2,7 @@
 //! and reports the offending values here.
 
 /// Everything that can go wrong when building a grading, a domain, a packing,
-/// running the genetic algorithm or writing an output.
+/// running the genetic algorithm, writing an output or reading one back.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -137,8 +137,20 @@ pub enum Error {
     /// inconsistently oriented, degenerate), as levelset reports it.
     #[error("container mesh: {0}")]
     Mesh(#[from] levelset::Error),
-    /// An I/O error from a writer.
-    #[error("writing output failed: {0}")]
+    /// A text format that cannot be read: the format, the 1-based line
+    /// number (one past the last line for problems found at the end of the
+    /// input) and what is wrong there.
+    #[error("{format} line {line}: {message}")]
+    Parse {
+        /// Format name (`"lammps data"`, `"yade text"`, `"csv"`, `"vtu"`).
+        format: &'static str,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// An I/O error from a reader or a writer.
+    #[error("reading or writing failed: {0}")]
     Io(#[from] std::io::Error),
 }
 

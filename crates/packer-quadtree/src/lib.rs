@@ -29,6 +29,11 @@
 //!   [`graded_layers`]: functionally graded property layers (§4.3);
 //! * writers: [`write_csv`], [`write_vtu`], [`write_lammps_data`],
 //!   [`write_yade`], [`write_svg`];
+//! * 3D sphere packings ([`Sphere`] in a [`Container`]): writers and
+//!   bit-exact round-trip readers [`write_lammps_data3`] /
+//!   [`read_lammps_data3`] (LAMMPS/LIGGGHTS `atom_style sphere`),
+//!   [`write_yade3`] / [`read_yade3`], [`write_csv3`] / [`read_csv3`],
+//!   [`write_vtu3`] / [`read_vtu3`];
 //! * particle in contact (Pérez Morales et al. 2016): closed-form wrappers
 //!   [`contact2d`] and [`contact3d`], gap functions with Newton and
 //!   Nelder–Mead [`gap`], grain shapes ([`Grain`], [`GrainShape`]:
@@ -94,8 +99,9 @@ pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };
 pub use pack3d::{
-    Container, MeshContainer, Pack3Params, Pack3Stats, Packing3, Sphere, pack3d, pack3d_seeded,
-    pack3d_sizes,
+    Container, LammpsData3, MeshContainer, Pack3Params, Pack3Stats, Packing3, Sphere, pack3d,
+    pack3d_seeded, pack3d_sizes, read_csv3, read_lammps_data3, read_vtu3, read_yade3, write_csv3,
+    write_lammps_data3, write_vtu3, write_yade3,
 };
 pub use packer::{
     BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,

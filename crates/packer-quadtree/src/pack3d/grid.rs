@@ -87,8 +87,16 @@ impl Grid3 {
     #[inline]
     pub(crate) fn for_each_near(&self, p: &[f64; 3], reach: f64, mut visit: impl FnMut(u32, [f64; 3])) {
         if !self.any_periodic {
-            let lo = [0, 1, 2].map(|k| self.coord(k, p[k] - reach));
-            let hi = [0, 1, 2].map(|k| self.coord(k, p[k] + reach));
+            let lo = [
+                self.coord(0, p[0] - reach),
+                self.coord(1, p[1] - reach),
+                self.coord(2, p[2] - reach),
+            ];
+            let hi = [
+                self.coord(0, p[0] + reach),
+                self.coord(1, p[1] + reach),
+                self.coord(2, p[2] + reach),
+            ];
             for iz in lo[2]..=hi[2] {
                 for iy in lo[1]..=hi[1] {
                     let row = self.n[0] * (iy + self.n[1] * iz);
