@@ -46,6 +46,14 @@ pub struct Pack3Params {
     /// A site takes the oldest of the next `lookahead` sizes that fits it
     /// (`1`: sizes strictly in draw order, as the seed's size list).
     pub lookahead: usize,
+    /// When no open site takes any size of the window, the oldest size is
+    /// skipped (counted in [`Pack3Stats::sizes_skipped`]) up to this many
+    /// times in a row before the packing ends. `0` (default) ends the
+    /// packing at the first size nothing takes, so the sizes placed are
+    /// exactly the drawn ones minus the window left over; larger values
+    /// fill the last pockets under the lid with small spheres (denser,
+    /// finer at the top).
+    pub max_skips: usize,
     /// Upper bound on the number of spheres (guards against a unit mistake
     /// exhausting memory; checked against the estimate before any work).
     pub max_particles: usize,
@@ -56,16 +64,21 @@ impl Default for Pack3Params {
         Self {
             front_order: FrontOrder::LowestCandidate,
             lookahead: 8,
+            max_skips: 0,
             max_particles: 50_000_000,
         }
     }
 }
 
 impl Pack3Params {
-    /// The densest configuration: the portfolio of front orders.
+    /// The densest configuration: the portfolio of front orders (run in
+    /// parallel, densest kept), a look-ahead of 32 sizes and up to 256
+    /// skipped sizes to fill the last pockets.
     pub fn dense() -> Self {
         Self {
             front_order: FrontOrder::Best,
+            lookahead: 32,
+            max_skips: 256,
             ..Self::default()
         }
     }
@@ -73,8 +86,15 @@ impl Pack3Params {
     /// Checks the parameters.
     ///
     /// # Errors
-    /// [`Error::Parameter`] for a zero particle limit.
+    /// [`Error::Parameter`] for a zero look-ahead or particle limit.
     pub fn validate(&self) -> Result<()> {
+        if self.lookahead == 0 {
+            return Err(Error::Parameter {
+                what: "lookahead",
+                value: 0.0,
+                range: "[1, inf)",
+            });
+        }
         if self.max_particles == 0 {
             return Err(Error::Parameter {
                 what: "max_particles",
@@ -226,7 +246,13 @@ pub fn pack3d_sizes(
         .map(|&order| {
             let mut f = front::Front3::new(container, 0.5 * lo, 0.5 * hi, sizes.len());
             let mut next = |k: usize| sizes.get(k).copied();
-            f.run(order, &mut next, params.max_particles, params.lookahead);
+            f.run(
+                order,
+                &mut next,
+                params.max_particles,
+                params.lookahead,
+                params.max_skips,
+            );
             let stats = f.stats;
             Packing3 {
                 spheres: f
@@ -258,3 +284,6 @@ pub fn pack3d_sizes(
         }),
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -152,37 +152,53 @@ impl Walls {
                 let (lo, hi) = container.bbox();
                 let ext = hi - lo;
                 let mut c = r_max;
-                while (ext.x / c + 3.0) * (ext.y / c + 3.0) * (ext.z / c + 3.0) > 2.0e6 {
+                while (ext.x / c + 3.0) * (ext.y / c + 3.0) * (ext.z / c + 3.0) > 5.0e5 {
                     c *= 1.25;
                 }
                 let n = [0, 1, 2].map(|k| (ext[k] / c).ceil() as usize + 2);
                 let lo = [lo.x - c, lo.y - c, lo.z - c];
                 let half_diag = c * 0.5 * 3f64.sqrt();
-                // Distinct face planes.
+                // Distinct face planes: sorted, then runs of equal planes
+                // (within round-off) merged.
+                let raw: Vec<Plane> = mesh
+                    .triangles()
+                    .iter()
+                    .map(|t| {
+                        let nrm = (v[t[1]] - v[t[0]]).cross(&(v[t[2]] - v[t[0]])).normalize();
+                        // Inward normal: the mesh is outward oriented.
+                        Plane {
+                            n: -nrm,
+                            o: -nrm.dot(&v[t[0]].coords),
+                        }
+                    })
+                    .collect();
+                let mut order: Vec<usize> = (0..raw.len()).collect();
+                order.sort_by(|&i, &j| {
+                    let (p, q) = (&raw[i], &raw[j]);
+                    p.n[0]
+                        .total_cmp(&q.n[0])
+                        .then(p.n[1].total_cmp(&q.n[1]))
+                        .then(p.n[2].total_cmp(&q.n[2]))
+                        .then(p.o.total_cmp(&q.o))
+                        .then(i.cmp(&j))
+                });
                 let mut planes: Vec<Plane> = Vec::new();
-                let mut tri_plane = Vec::with_capacity(mesh.triangles().len());
-                for t in mesh.triangles() {
-                    let nrm = (v[t[1]] - v[t[0]]).cross(&(v[t[2]] - v[t[0]])).normalize();
-                    // Inward normal: the mesh is outward oriented.
-                    let p = Plane {
-                        n: -nrm,
-                        o: -nrm.dot(&v[t[0]].coords),
-                    };
-                    let found = planes.iter().position(|q| {
+                let mut tri_plane = vec![0u32; raw.len()];
+                for &t in &order {
+                    let p = raw[t];
+                    let same = planes.last().is_some_and(|q| {
                         (q.n - p.n).norm() <= 1e-9 && (q.o - p.o).abs() <= 1e-9 * (1.0 + q.o.abs())
                     });
-                    tri_plane.push(match found {
-                        Some(i) => i as u32,
-                        None => {
-                            planes.push(p);
-                            (planes.len() - 1) as u32
-                        }
-                    });
+                    if !same {
+                        planes.push(p);
+                    }
+                    tri_plane[t] = (planes.len() - 1) as u32;
                 }
                 let reach = 3.0 * r_max + half_diag;
                 let cells = n[0] * n[1] * n[2];
+                // Lower bound of the clearance over each cell, from the exact
+                // clearance at its centre.
                 let mut deep = vec![f64::NEG_INFINITY; cells];
-                let mut per_cell: Vec<Vec<u32>> = vec![Vec::new(); cells];
                 for iz in 0..n[2] {
                     for iy in 0..n[1] {
                         for ix in 0..n[0] {
@@ -192,16 +208,36 @@ impl Walls {
                                 lo[1] + (iy as f64 + 0.5) * c,
                                 lo[2] + (iz as f64 + 0.5) * c,
                             );
-                            let cl = m.clearance_bounded(&p, reach + half_diag);
-                            deep[idx] = cl - half_diag;
-                            if cl.abs() <= reach {
-                                for (t, tri) in mesh.triangles().iter().enumerate() {
-                                    let d = levelset_point_triangle(&p, v[tri[0]], v[tri[1]], v[tri[2]]);
-                                    if d <= reach {
-                                        let pl = tri_plane[t];
-                                        if !per_cell[idx].contains(&pl) {
-                                            per_cell[idx].push(pl);
-                                        }
+                            deep[idx] = m.clearance_bounded(&p, reach + half_diag) - half_diag;
+                        }
+                    }
+                }
+                // Face planes near each cell: every triangle visits the
+                // cells of its box widened by the reach.
+                let mut per_cell: Vec<Vec<u32>> = vec![Vec::new(); cells];
+                for (t, tri) in mesh.triangles().iter().enumerate() {
+                    let (a, b2, c2) = (v[tri[0]], v[tri[1]], v[tri[2]]);
+                    let tlo = a.inf(&b2).inf(&c2);
+                    let thi = a.sup(&b2).sup(&c2);
+                    let range = |k: usize| {
+                        let i0 = (((tlo[k] - reach - lo[k]) / c).floor().max(0.0)) as usize;
+                        let i1 = ((((thi[k] + reach - lo[k]) / c).floor()) as usize).min(n[k] - 1);
+                        (i0, i1)
+                    };
+                    let ((x0, x1), (y0, y1), (z0, z1)) = (range(0), range(1), range(2));
+                    for iz in z0..=z1 {
+                        for iy in y0..=y1 {
+                            for ix in x0..=x1 {
+                                let idx = ix + n[0] * (iy + n[1] * iz);
+                                let p = Point3::new(
+                                    lo[0] + (ix as f64 + 0.5) * c,
+                                    lo[1] + (iy as f64 + 0.5) * c,
+                                    lo[2] + (iz as f64 + 0.5) * c,
+                                );
+                                if levelset_point_triangle(&p, a, b2, c2) <= reach {
+                                    let pl = tri_plane[t];
+                                    if !per_cell[idx].contains(&pl) {
+                                        per_cell[idx].push(pl);
                                     }
                                 }
                             }
@@ -281,8 +317,12 @@ fn lower(a: &[f64; 3], b: &[f64; 3]) -> bool {
 /// [`CYL`] the cylinder side.
 const WALL: u32 = 0xFFFF_0000;
 const CYL: u32 = u32::MAX;
+/// Third obstacle of the bootstrap site of a box periodic in x and y: the
+/// second sphere touches the first and the floor on the first's `+x` side.
+const FREE: u32 = u32::MAX - 1;
 
-/// Consecutive sizes skipped before the packing is declared full.
+/// Sizes tried for the first sphere before the container is declared too
+/// small.
 const MAX_SKIPS: usize = 256;
 
 /// An open site: where a sphere touches the three obstacles `ids`
@@ -823,6 +863,12 @@ impl<'a> Front3<'a> {
         };
         let mut tmp = Pts::default();
         let [_, a, b] = site.ids;
+        if b == FREE {
+            let w = self.all_planes[(a - WALL) as usize];
+            let zc = (w.o + r) / w.n[2] - c0[2];
+            let s2 = rho02 - zc * zc;
+            return (s2 >= 0.0).then(|| [c0[0] + s2.sqrt(), c0[1], c0[2] + zc]);
+        }
         match (a < WALL, b < WALL, b == CYL) {
             (true, true, _) => three_spheres(&rel(a), &rel(b), rho02, &mut tmp),
             (true, false, false) => sphere_sphere_plane(&rel(a), &plane(b), rho02, &mut tmp),
@@ -925,6 +971,7 @@ impl<'a> Front3<'a> {
         sizes: &mut dyn FnMut(usize) -> Option<f64>,
         max: usize,
         lookahead: usize,
+        max_skips: usize,
     ) {
         let mut k = 0usize;
         let first = loop {
@@ -949,6 +996,19 @@ impl<'a> Front3<'a> {
         let mut sites = Sites::new(self.r_min, self.r_max);
         let g = gkey(self, first);
         self.generate(first, g, &mut sites);
+        if sites.is_empty()
+            && let Some(floor) = self.all_planes.iter().position(|w| w.n[2] > 0.999_999)
+        {
+            // Periodic in x and y: nothing but the floor around the first
+            // sphere; the second one sits beside it.
+            let q = self.xs[first as usize];
+            sites.push(Site {
+                k: [q[0] + q[3] + self.r_min, q[1], q[2]],
+                ids: [first, WALL + floor as u32, FREE],
+                g,
+                cap: f64::INFINITY,
+            });
+        }
         // The window of upcoming radii, oldest first.
         let w = lookahead.max(1);
         let mut window: Vec<f64> = Vec::with_capacity(w);
@@ -966,7 +1026,7 @@ impl<'a> Front3<'a> {
         while self.xs.len() < max && !window.is_empty() {
             let r_small = window.iter().copied().fold(f64::INFINITY, f64::min);
             let Some(site) = sites.pop_for(r_small) else {
-                if sites.is_empty() || skips >= MAX_SKIPS {
+                if sites.is_empty() || skips >= max_skips {
                     break;
                 }
                 // No site takes any size of the window: skip the oldest.
@@ -1260,5 +1320,65 @@ fn circle_cylinder(a: &Nb, rho_f2: f64, ax: [f64; 2], rr: f64, out: &mut Pts) {
         }
         t0 = t1;
         g0 = g1;
+    }
+}
+
+/// Test access to the closed forms.
+#[cfg(test)]
+pub(crate) mod tests_api {
+    use super::*;
+
+    /// Centres of a sphere of radius `r` tangent to three spheres, through
+    /// the packer's inlined closed form.
+    pub(crate) fn three(c: &[(Point3<f64>, f64)], r: f64) -> Vec<Point3<f64>> {
+        let f = c[0];
+        let rho_f = f.1 + r;
+        let nb = |o: (Point3<f64>, f64)| {
+            let d = o.0 - f.0;
+            let dd = d.norm_squared();
+            let rho = o.1 + r;
+            Nb {
+                d: [d.x, d.y, d.z],
+                dd,
+                rho,
+                b: 0.5 * (dd + rho_f * rho_f - rho * rho),
+                id: 0,
+            }
+        };
+        let mut out = Pts::default();
+        three_spheres(&nb(c[1]), &nb(c[2]), rho_f * rho_f, &mut out);
+        out.as_slice()
+            .iter()
+            .map(|y| f.0 + Vector3::new(y[0], y[1], y[2]))
+            .collect()
+    }
+
+    /// Centres touching a front sphere, an obstacle sphere and the inside
+    /// of a cylinder of `radius` around the z axis.
+    pub(crate) fn circle_cylinder(
+        cf: [f64; 3],
+        rf: f64,
+        ca: [f64; 3],
+        ra: f64,
+        r: f64,
+        radius: f64,
+    ) -> Vec<[f64; 3]> {
+        let rho_f = rf + r;
+        let d = [ca[0] - cf[0], ca[1] - cf[1], ca[2] - cf[2]];
+        let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let rho = ra + r;
+        let a = Nb {
+            d,
+            dd,
+            rho,
+            b: 0.5 * (dd + rho_f * rho_f - rho * rho),
+            id: 0,
+        };
+        let mut out = Pts::default();
+        super::circle_cylinder(&a, rho_f * rho_f, [-cf[0], -cf[1]], radius - r, &mut out);
+        out.as_slice()
+            .iter()
+            .map(|y| [y[0] + cf[0], y[1] + cf[1], y[2] + cf[2]])
+            .collect()
     }
 }
