@@ -22,6 +22,7 @@ mod calibrate;
 mod clone_cmd;
 mod convergence;
 mod dna;
+mod pack3d_cmd;
 mod pack_cmd;
 mod parents;
 mod progress;
@@ -54,8 +55,9 @@ enum Command {
     /// Measure the morphological DNA of every shipped real grain into
     /// `fixtures/dna/` (`--check` verifies the committed table).
     Dna(dna::Dna),
-    /// Pack a 2D domain with disks (Pinto 2009's advancing front) and write
-    /// CSV, VTU (ParaView), LIGGGHTS/LAMMPS data, Yade text and SVG.
+    /// Pack a 2D domain with disks (Pinto 2009's advancing front) or a 3D
+    /// container with spheres (`--dim 3 --container …`) and write CSV, VTU
+    /// (ParaView), LIGGGHTS/LAMMPS data, Yade text (and SVG in 2D).
     Pack(pack_cmd::Pack),
     /// Write a synthetic labelled CT image of cloned grains (scale tests of
     /// `--parents`).

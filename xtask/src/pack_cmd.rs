@@ -88,9 +88,18 @@ pub(crate) struct Pack {
     /// These write `packing.vtu` only.
     #[arg(long, default_value = "disk")]
     shape: String,
-    /// Dimension of the particle-in-contact packer (2 or 3).
+    /// Dimension: 2 (disks, or the particle-in-contact packer with
+    /// `--shape`) or 3 (spheres in `--container` by the 3D advancing front;
+    /// with `--shape`, the particle-in-contact packer in 3D).
     #[arg(long, default_value_t = 2)]
     dim: usize,
+    /// 3D container, lengths in the grading's unit:
+    /// `box:LX,LY,LZ[,periodic|periodic-x]` (walls, or periodic in x and y /
+    /// in x), `cylinder:D[,H]` (vertical, H = 2 D by default: the triaxial
+    /// specimen) or `mesh:FILE` (a closed STL or OBJ surface). Implies
+    /// `--dim 3`; default with `--dim 3`: `box:80,80,80`.
+    #[arg(long)]
+    container: Option<String>,
     /// Side of the square/cube of the particle-in-contact packer.
     #[arg(long, default_value_t = 20.0)]
     side: f64,
@@ -303,6 +312,19 @@ pub(crate) fn parse_grading(s: &str) -> anyhow::Result<Grading> {
 
 impl Pack {
     pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
+        if self.shape == "disk" && (self.dim == 3 || self.container.is_some()) {
+            let container = self.container.as_deref().unwrap_or("box:80,80,80");
+            return crate::pack3d_cmd::Run3 {
+                container,
+                grading: parse_grading(&self.grading)?,
+                preset: self.preset,
+                seed: self.seed,
+                formats: &self.formats,
+                density: self.density,
+                out: self.out.clone(),
+            }
+            .run(root);
+        }
         if self.shape != "disk" {
             let (dim, params) = parse_shape(
                 &self.shape,

@@ -360,6 +360,9 @@ impl Ord for Site {
     }
 }
 
+/// Sites of one generation closer than `DEDUP · r_min` are one pocket.
+const DEDUP: f64 = 1.0;
+
 /// Bisection steps of a site's capacity.
 const BISECTIONS: usize = 4;
 
@@ -474,6 +477,8 @@ pub(crate) struct Front3<'a> {
     cands: Vec<([f64; 3], u32, u32)>,
     /// Spheres near a site (periodic images applied), for repeated tests.
     local: Vec<[f64; 4]>,
+    /// Feasible sites of one generation.
+    kept: Vec<([f64; 3], u32, u32)>,
     last_block: usize,
     pub(crate) stats: Pack3Stats,
 }
@@ -505,6 +510,7 @@ impl<'a> Front3<'a> {
             planes: Vec::with_capacity(16),
             cands: Vec::with_capacity(1024),
             local: Vec::with_capacity(128),
+            kept: Vec::with_capacity(64),
             last_block: 0,
             stats: Pack3Stats::default(),
         }
@@ -783,20 +789,44 @@ impl<'a> Front3<'a> {
         }
         self.stats.neighbours += n as u64;
         self.stats.candidates += self.cands.len() as u64;
-        let cands = std::mem::take(&mut self.cands);
+        let mut cands = std::mem::take(&mut self.cands);
+        let mut kept = std::mem::take(&mut self.kept);
+        kept.clear();
         for (y, a, b) in &cands {
             let p = [y[0] + cf[0], y[1] + cf[1], y[2] + cf[2]];
             if self.free(y) && self.inside(&p, r) {
-                self.stats.sites += 1;
-                out.push(Site {
-                    k: p,
-                    ids: [f, *a, *b],
-                    g,
-                    cap: f64::INFINITY,
-                });
+                kept.push((p, *a, *b));
             }
         }
+        // One site per pocket: sites of this batch closer than `DEDUP ·
+        // r_min` describe the same hole; the lowest is kept.
+        kept.sort_by(|x, y| {
+            x.0[2]
+                .total_cmp(&y.0[2])
+                .then(x.0[0].total_cmp(&y.0[0]))
+                .then(x.0[1].total_cmp(&y.0[1]))
+                .then((x.1, x.2).cmp(&(y.1, y.2)))
+        });
+        let eps2 = (DEDUP * r).powi(2);
+        for i in 0..kept.len() {
+            let (p, a, b) = kept[i];
+            let dup = kept[..i].iter().any(|(q, _, _)| {
+                (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2) < eps2
+            });
+            if dup {
+                continue;
+            }
+            self.stats.sites += 1;
+            out.push(Site {
+                k: p,
+                ids: [f, a, b],
+                g,
+                cap: f64::INFINITY,
+            });
+        }
+        cands.clear();
         self.cands = cands;
+        self.kept = kept;
     }
 
     /// `y` (relative to the generating sphere) outside every neighbour halo.
