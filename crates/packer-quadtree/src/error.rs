@@ -137,6 +137,29 @@ pub enum Error {
     /// inconsistently oriented, degenerate), as levelset reports it.
     #[error("container mesh: {0}")]
     Mesh(#[from] levelset::Error),
+    /// A margin that leaves no core region inside the container.
+    #[error("margin {margin} leaves an empty core region")]
+    EmptyCore {
+        /// The offending margin.
+        margin: f64,
+    },
+    /// A metric that only applies to one kind of container.
+    #[error("{what} needs a {expected} container, got a {got}")]
+    WrongContainer {
+        /// The metric.
+        what: &'static str,
+        /// The container kind it needs.
+        expected: &'static str,
+        /// The container kind given.
+        got: &'static str,
+    },
+    /// The independent checker could not build its own (parry) copy of a
+    /// container mesh.
+    #[error("checker mesh: {reason}")]
+    CheckerMesh {
+        /// What parry reported.
+        reason: String,
+    },
     /// An I/O error from a writer.
     #[error("writing output failed: {0}")]
     Io(#[from] std::io::Error),

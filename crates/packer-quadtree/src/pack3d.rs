@@ -5,8 +5,13 @@
 //! overlap checker and writers for LAMMPS/LIGGGHTS, Yade, CSV and VTU.
 
 mod container;
+mod metrics;
 
 pub use container::{Container, MeshContainer};
+pub use metrics::{
+    CoreFraction, GradingReport, GradingStats, RadialBin, SphereReport, check_spheres,
+    core_solid_fraction, grading_report, radial_profile, solid_fraction,
+};
 
 use nalgebra::Point3;
 

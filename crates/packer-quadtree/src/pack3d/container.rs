@@ -30,14 +30,18 @@ impl MeshContainer {
     /// A mesh oriented inwards (negative signed volume) is flipped.
     ///
     /// # Errors
-    /// [`Error::Mesh`] naming the first open or non-manifold edge or the
-    /// degenerate triangle; [`Error::NonPositive`] for a zero volume.
+    /// [`Error::Mesh`](crate::Error::Mesh) naming the first open or non-manifold edge or the
+    /// degenerate triangle; [`Error::NonPositive`](crate::Error::NonPositive) for a zero volume.
     pub fn new(mesh: TriMesh) -> Result<Self> {
         let mut mesh = mesh;
         mesh.check_closed()?;
         let mut volume = mesh.signed_volume();
         if volume < 0.0 {
-            let tris = mesh.triangles().iter().map(|t| [t[0], t[2], t[1]]).collect();
+            let tris = mesh
+                .triangles()
+                .iter()
+                .map(|t| [t[0], t[2], t[1]])
+                .collect();
             mesh = TriMesh::new(mesh.vertices().to_vec(), tris)?;
             volume = -volume;
         }
@@ -137,7 +141,8 @@ impl Container {
     /// Checks the geometry (finite, positive extents).
     ///
     /// # Errors
-    /// [`Error::NonFinite`] / [`Error::NonPositive`] naming the field.
+    /// [`Error::NonFinite`](crate::Error::NonFinite) /
+    /// [`Error::NonPositive`](crate::Error::NonPositive) naming the field.
     pub fn validate(&self) -> Result<()> {
         match self {
             Self::Box { min, max, .. } => {
@@ -167,7 +172,9 @@ impl Container {
     pub fn volume(&self) -> f64 {
         match self {
             Self::Box { min, max, .. } => (max - min).product(),
-            Self::Cylinder { radius, height, .. } => std::f64::consts::PI * radius * radius * height,
+            Self::Cylinder { radius, height, .. } => {
+                std::f64::consts::PI * radius * radius * height
+            }
             Self::Mesh(m) => m.volume,
         }
     }
