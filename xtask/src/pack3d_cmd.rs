@@ -205,8 +205,8 @@ fn metrics_report(container: &Container, grading: &Grading, p: &Packing3) -> any
         bail!(
             "the independent checker rejects this packing (worst pair gap / d {:.2e}, worst wall \
              gap / d {:.2e}): nothing written; please report it with the command line",
-            check.worst_pair_relative_gap,
-            check.worst_wall_relative_gap
+            check.worst_normalised_gap,
+            check.worst_normalised_wall_gap
         );
     }
     let overall = packer_quadtree::solid_fraction(container, &p.spheres)?;
@@ -215,9 +215,9 @@ fn metrics_report(container: &Container, grading: &Grading, p: &Packing3) -> any
         "{} spheres, solid fraction {overall:.4} overall; mean coordination number {:.2}; worst \
          gap / d {:.2e} (pairs), {:.2e} (walls)",
         p.spheres.len(),
-        check.coordination,
-        check.worst_pair_relative_gap,
-        check.worst_wall_relative_gap
+        check.coordination_number,
+        check.worst_normalised_gap,
+        check.worst_normalised_wall_gap
     );
     match packer_quadtree::core_solid_fraction(container, &p.spheres, 2.0 * d_max) {
         Ok(core) => {

@@ -53,7 +53,8 @@ pub(crate) struct Pack {
     #[arg(long, default_value = "rect:100,100")]
     domain: String,
     /// Grading, in mm: `pinto-3.4` (Pinto 2009, Table 3.4), `ap5`
-    /// (Table 4.1), `constant:D`, `uniform:MIN,MAX`, or
+    /// (Table 4.1), `constant:D`, `uniform:MIN,MAX`,
+    /// `lognormal:MEDIAN,SIGMA,MIN,MAX` (σ of ln d, truncated), or
     /// `sieve:SIZE:PASSING%,SIZE:PASSING%,...` (increasing sizes, 0 % first,
     /// 100 % last).
     #[arg(long, default_value = "pinto-3.4")]
@@ -285,6 +286,15 @@ pub(crate) fn parse_grading(s: &str) -> anyhow::Result<Grading> {
             let [min, max] = exactly(numbers(rest, "uniform")?, "uniform")?;
             Grading::Uniform { min, max }
         }
+        "lognormal" => {
+            let [median, sigma, min, max] = exactly(numbers(rest, "lognormal")?, "lognormal")?;
+            Grading::LogNormal {
+                median,
+                sigma,
+                min,
+                max,
+            }
+        }
         "sieve" => {
             let (mut sizes, mut passing) = (Vec::new(), Vec::new());
             for pair in rest.split(',') {
@@ -304,7 +314,9 @@ pub(crate) fn parse_grading(s: &str) -> anyhow::Result<Grading> {
             }
             Grading::Sieve { sizes, passing }
         }
-        _ => bail!("unknown grading `{kind}` (pinto-3.4, ap5, constant, uniform, sieve)"),
+        _ => bail!(
+            "unknown grading `{kind}` (pinto-3.4, ap5, constant, uniform, lognormal, sieve)"
+        ),
     };
     g.validate()?;
     Ok(g)

@@ -149,6 +149,29 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A margin that leaves no core region inside the container.
+    #[error("margin {margin} leaves an empty core region")]
+    EmptyCore {
+        /// The offending margin.
+        margin: f64,
+    },
+    /// A metric that only applies to one kind of container.
+    #[error("{what} needs a {expected} container, got a {got}")]
+    WrongContainer {
+        /// The metric.
+        what: &'static str,
+        /// The container kind it needs.
+        expected: &'static str,
+        /// The container kind given.
+        got: &'static str,
+    },
+    /// The independent checker could not build its own (parry) copy of a
+    /// container mesh.
+    #[error("checker mesh: {reason}")]
+    CheckerMesh {
+        /// What parry reported.
+        reason: String,
+    },
     /// An I/O error from a reader or a writer.
     #[error("reading or writing failed: {0}")]
     Io(#[from] std::io::Error),

@@ -8,6 +8,12 @@
 //! `d = d_i (d_{i+1}/d_i)^t` with `t = (P − P_i)/(P_{i+1} − P_i)`
 //! (Pinto 2009, §4.2.1: "a regra de três … tratado devido ao gráfico ser
 //! semilogarítmico").
+//!
+//! A [`Grading::LogNormal`] is truncated to `[min, max]`; its inverse CDF
+//! uses an inverse normal accurate to double precision (Acklam's rational
+//! approximation refined by Halley steps on a careful `erfc`). Every
+//! curve is a **number** distribution (one draw per particle); the mass
+//! curve of the geotechnical report is derived from it (`MassCurve`).
 
 use crate::error::{Error, Result, finite, positive};
 use rand::Rng;
@@ -51,6 +57,20 @@ pub enum Grading {
     /// A piecewise mixture over passing ranges that tile 0–100 %
     /// (Pinto 2009, Table 4.1).
     Mixture(Vec<MixtureComponent>),
+    /// Log-normal by number: `ln d` is normal with mean `ln median` and
+    /// standard deviation `sigma`, truncated to `[min, max]` (the number
+    /// distribution is renormalised on the interval, so `median` is the
+    /// median of the untruncated law).
+    LogNormal {
+        /// Median diameter of the untruncated distribution.
+        median: f64,
+        /// Standard deviation of `ln d` (dimensionless).
+        sigma: f64,
+        /// Smallest diameter (truncation).
+        min: f64,
+        /// Largest diameter (truncation).
+        max: f64,
+    },
 }
 
 impl Grading {
@@ -93,7 +113,9 @@ impl Grading {
     /// [`Error::NonFinite`], [`Error::NonPositive`], [`Error::InvertedRange`],
     /// [`Error::GradingTooShort`], [`Error::GradingLengthMismatch`],
     /// [`Error::GradingNotMonotone`], [`Error::GradingRange`],
-    /// [`Error::MixtureNotTiling`] for the corresponding defect.
+    /// [`Error::MixtureNotTiling`] for the corresponding defect;
+    /// [`Error::Parameter`] for a log-normal whose interval `[min, max]`
+    /// has a probability below `1e-250` (too far in a tail to sample).
     pub fn validate(&self) -> Result<()> {
         match self {
             Self::Constant { diameter } => {
@@ -159,6 +181,31 @@ impl Grading {
                     return Err(Error::MixtureNotTiling { at });
                 }
             }
+            Self::LogNormal {
+                median,
+                sigma,
+                min,
+                max,
+            } => {
+                positive("log-normal median", *median)?;
+                positive("log-normal sigma", *sigma)?;
+                positive("log-normal min", *min)?;
+                positive("log-normal max", *max)?;
+                if min >= max {
+                    return Err(Error::InvertedRange {
+                        min: *min,
+                        max: *max,
+                    });
+                }
+                let t = Truncated::new(*median, *sigma, *min, *max);
+                if t.mass.is_nan() || t.mass < 1e-250 {
+                    return Err(Error::Parameter {
+                        what: "log-normal probability of [min, max]",
+                        value: t.mass,
+                        range: "[1e-250, 1]",
+                    });
+                }
+            }
         }
         Ok(())
     }
@@ -174,6 +221,7 @@ impl Grading {
                 sizes[i]
             }
             Self::Mixture(c) => c.iter().map(|c| c.grading.d_min()).fold(f64::MAX, f64::min),
+            Self::LogNormal { min, .. } => *min,
         }
     }
 
@@ -190,6 +238,7 @@ impl Grading {
                 sizes[i]
             }
             Self::Mixture(c) => c.iter().map(|c| c.grading.d_max()).fold(0.0, f64::max),
+            Self::LogNormal { max, .. } => *max,
         }
     }
 
@@ -223,6 +272,21 @@ impl Grading {
                 components
                     .last()
                     .map_or(0.0, |c| c.grading.diameter_at(1.0))
+            }
+            Self::LogNormal {
+                median,
+                sigma,
+                min,
+                max,
+            } => {
+                if u <= 0.0 {
+                    return *min;
+                }
+                if u >= 1.0 {
+                    return *max;
+                }
+                let t = Truncated::new(*median, *sigma, *min, *max);
+                (median * (sigma * t.quantile(u)).exp()).clamp(*min, *max)
             }
         }
     }
@@ -263,6 +327,21 @@ impl Grading {
                 }
                 best
             }
+            Self::LogNormal {
+                median,
+                sigma,
+                min,
+                max,
+            } => {
+                if d <= *min {
+                    return 0.0;
+                }
+                if d >= *max {
+                    return 1.0;
+                }
+                let t = Truncated::new(*median, *sigma, *min, *max);
+                t.cdf((d / median).ln() / sigma)
+            }
         }
     }
 
@@ -277,6 +356,289 @@ impl Grading {
 /// `n_est = ⌈a_c / a_p,min⌉` with `a_p,min = π d_min² / 4`.
 pub fn estimate_count(domain_area: f64, d_min: f64) -> f64 {
     (domain_area / (std::f64::consts::PI * d_min * d_min / 4.0)).ceil()
+}
+
+/// The standard normal law truncated to `[za, zb]`. When the interval
+/// leans into the upper half (`za + zb > 0`) every probability is an
+/// upper-tail one, `Q(z) = Φ(−z)`, so that far tails keep full precision.
+struct Truncated {
+    za: f64,
+    zb: f64,
+    upper: bool,
+    /// `Φ(za)` (or `Q(za)` when `upper`).
+    pa: f64,
+    /// Probability of `[za, zb]`.
+    mass: f64,
+}
+
+impl Truncated {
+    fn new(median: f64, sigma: f64, min: f64, max: f64) -> Self {
+        let za = (min / median).ln() / sigma;
+        let zb = (max / median).ln() / sigma;
+        // The formulation of the tail the interval leans into.
+        let upper = za + zb > 0.0;
+        let (pa, pb) = if upper {
+            (norm_cdf(-za), norm_cdf(-zb))
+        } else {
+            (norm_cdf(za), norm_cdf(zb))
+        };
+        Self {
+            za,
+            zb,
+            upper,
+            pa,
+            mass: (pb - pa).abs(),
+        }
+    }
+
+    /// Truncated CDF at the standard score `z`.
+    fn cdf(&self, z: f64) -> f64 {
+        if z <= self.za {
+            return 0.0;
+        }
+        if z >= self.zb {
+            return 1.0;
+        }
+        let f = if self.upper {
+            (self.pa - norm_cdf(-z)) / self.mass
+        } else {
+            (norm_cdf(z) - self.pa) / self.mass
+        };
+        f.clamp(0.0, 1.0)
+    }
+
+    /// Standard score at truncated cumulative probability `u ∈ [0, 1]`.
+    fn quantile(&self, u: f64) -> f64 {
+        if u <= 0.0 {
+            return self.za;
+        }
+        if u >= 1.0 {
+            return self.zb;
+        }
+        let z = if self.upper {
+            -norm_ppf(self.pa - u * self.mass)
+        } else {
+            norm_ppf(self.pa + u * self.mass)
+        };
+        z.clamp(self.za, self.zb)
+    }
+}
+
+/// `2/√π`.
+const TWO_OVER_SQRT_PI: f64 = std::f64::consts::FRAC_2_SQRT_PI;
+
+/// Complementary error function, relative accuracy about `1e-15`
+/// (`2e-14` near `x = 1.5`, where `1 − erf` cancels most).
+///
+/// For `|x| < 1.5`, `erf` from the series of positive terms
+/// `erf x = 2/√π e^{−x²} Σ 2ⁿ x^{2n+1} / (1·3···(2n+1))`
+/// (Abramowitz & Stegun 1964, Eq. 7.1.6); beyond, the continued fraction
+/// `erfc x = e^{−x²}/√π · 1/(x + ½/(x + 1/(x + 3/2/(x + …))))`
+/// (A&S Eq. 7.1.14), evaluated by the modified Lentz method;
+/// `erfc(−x) = 2 − erfc(x)`.
+pub(crate) fn erfc(x: f64) -> f64 {
+    if x.is_nan() {
+        return f64::NAN;
+    }
+    if x < 0.0 {
+        return 2.0 - erfc(-x);
+    }
+    if x < 1.5 {
+        return 1.0 - erf_series(x);
+    }
+    if x > 27.5 {
+        return 0.0;
+    }
+    // Modified Lentz for F = x + a1/(x + a2/(x + …)), a_n = n/2.
+    let tiny = 1e-300;
+    let mut f = x;
+    let mut c = f;
+    let mut d = 0.0;
+    for n in 1..5000 {
+        let a = 0.5 * f64::from(n);
+        d = x + a * d;
+        if d.abs() < tiny {
+            d = tiny;
+        }
+        c = x + a / c;
+        if c.abs() < tiny {
+            c = tiny;
+        }
+        d = 1.0 / d;
+        let delta = c * d;
+        f *= delta;
+        if (delta - 1.0).abs() < 1e-16 {
+            break;
+        }
+    }
+    0.5 * TWO_OVER_SQRT_PI * (-x * x).exp() / f
+}
+
+/// `erf x` by the series of positive terms (A&S Eq. 7.1.6), `x ≥ 0` small.
+fn erf_series(x: f64) -> f64 {
+    let x2 = x * x;
+    let mut term = x;
+    let mut sum = x;
+    for n in 1..200 {
+        term *= 2.0 * x2 / f64::from(2 * n + 1);
+        sum += term;
+        if term < 1e-17 * sum {
+            break;
+        }
+    }
+    TWO_OVER_SQRT_PI * (-x2).exp() * sum
+}
+
+/// Standard normal CDF `Φ(z) = erfc(−z/√2)/2`.
+pub(crate) fn norm_cdf(z: f64) -> f64 {
+    0.5 * erfc(-z * std::f64::consts::FRAC_1_SQRT_2)
+}
+
+/// Inverse standard normal CDF: Acklam's rational approximation (relative
+/// error `1.15e-9`) refined by Halley steps on [`norm_cdf`] to full double
+/// precision. `p ≤ 0` gives `−∞`, `p ≥ 1` gives `+∞`; the upper half is
+/// mirrored (`Φ⁻¹(p) = −Φ⁻¹(1 − p)`, `1 − p` exact there) so that every
+/// Halley residual is a lower-tail probability.
+pub(crate) fn norm_ppf(p: f64) -> f64 {
+    if p.is_nan() {
+        return f64::NAN;
+    }
+    if p <= 0.0 {
+        return f64::NEG_INFINITY;
+    }
+    if p >= 1.0 {
+        return f64::INFINITY;
+    }
+    if p > 0.5 {
+        return -norm_ppf(1.0 - p);
+    }
+    const A: [f64; 6] = [
+        -3.969_683_028_665_376e1,
+        2.209_460_984_245_205e2,
+        -2.759_285_104_469_687e2,
+        1.383_577_518_672_69e2,
+        -3.066_479_806_614_716e1,
+        2.506_628_277_459_239,
+    ];
+    const B: [f64; 5] = [
+        -5.447_609_879_822_406e1,
+        1.615_858_368_580_409e2,
+        -1.556_989_798_598_866e2,
+        6.680_131_188_771_972e1,
+        -1.328_068_155_288_572e1,
+    ];
+    const C: [f64; 6] = [
+        -7.784_894_002_430_293e-3,
+        -3.223_964_580_411_365e-1,
+        -2.400_758_277_161_838,
+        -2.549_732_539_343_734,
+        4.374_664_141_464_968,
+        2.938_163_982_698_783,
+    ];
+    const D: [f64; 4] = [
+        7.784_695_709_041_462e-3,
+        3.224_671_290_700_398e-1,
+        2.445_134_137_142_996,
+        3.754_408_661_907_416,
+    ];
+    let mut x = if p < 0.02425 {
+        let q = (-2.0 * p.ln()).sqrt();
+        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
+            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
+    } else {
+        let q = p - 0.5;
+        let r = q * q;
+        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
+            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
+    };
+    // Halley on Φ(x) − p: cubic convergence, so two steps from 1e-9 are
+    // more than enough; stop when the step no longer changes x.
+    let sqrt_2pi = (2.0 * std::f64::consts::PI).sqrt();
+    for _ in 0..3 {
+        let e = norm_cdf(x) - p;
+        let u = e * sqrt_2pi * (0.5 * x * x).exp();
+        if !u.is_finite() {
+            break;
+        }
+        let step = u / (1.0 + 0.5 * x * u);
+        x -= step;
+        if step.abs() <= 1e-16 * x.abs() {
+            break;
+        }
+    }
+    x
+}
+
+/// Cumulative passing **by mass** of a number distribution, for the
+/// geotechnical grading report.
+///
+/// [`Grading`] curves are number distributions: the packer draws one
+/// diameter per particle with [`Grading::sample`]. With `D(u)` the inverse
+/// number CDF ([`Grading::diameter_at`]) and mass ∝ `d³`, the mass fraction
+/// passing `d` is `M(F(d))` with `M(u) = ∫₀ᵘ D(v)³ dv / ∫₀¹ D(v)³ dv`
+/// (the substitution `d = D(v)` in `∫ s³ dF(s)`), which also handles atoms
+/// (constant diameters) exactly. `M` is tabulated once by two-point
+/// Gauss–Legendre on `2¹⁴` equal cells of `u`.
+pub(crate) struct MassCurve<'a> {
+    grading: &'a Grading,
+    /// `M(k / N)`, `k = 0..=N`, normalised to end at 1.
+    cum: Vec<f64>,
+}
+
+impl<'a> MassCurve<'a> {
+    const CELLS: usize = 1 << 14;
+
+    /// Tabulates `M` for a validated grading.
+    pub(crate) fn new(grading: &'a Grading) -> Self {
+        let n = Self::CELLS;
+        let h = 1.0 / n as f64;
+        let off = 0.5 / 3f64.sqrt();
+        let mut cum = Vec::with_capacity(n + 1);
+        let mut acc = 0.0;
+        cum.push(0.0);
+        for k in 0..n {
+            let mid = (k as f64 + 0.5) * h;
+            let d1 = grading.diameter_at(mid - off * h);
+            let d2 = grading.diameter_at(mid + off * h);
+            acc += 0.5 * h * (d1 * d1 * d1 + d2 * d2 * d2);
+            cum.push(acc);
+        }
+        if acc > 0.0 {
+            for c in &mut cum {
+                *c /= acc;
+            }
+        }
+        Self { grading, cum }
+    }
+
+    /// `M(u)`, linear between the tabulated nodes.
+    fn at_u(&self, u: f64) -> f64 {
+        let n = Self::CELLS;
+        let s = u.clamp(0.0, 1.0) * n as f64;
+        let k = (s.floor() as usize).min(n - 1);
+        let t = s - k as f64;
+        self.cum[k] + t * (self.cum[k + 1] - self.cum[k])
+    }
+
+    /// Mass fraction (0–1) passing the size `d`.
+    pub(crate) fn passing(&self, d: f64) -> f64 {
+        self.at_u(self.grading.passing_at(d))
+    }
+
+    /// Size at which the mass fraction `x ∈ [0, 1]` passes (`D_x` by mass).
+    pub(crate) fn quantile(&self, x: f64) -> f64 {
+        let n = Self::CELLS;
+        let x = x.clamp(0.0, 1.0);
+        // First node with cum > x: the cell [k, k + 1] holds x.
+        let k = self.cum.partition_point(|&c| c <= x).clamp(1, n) - 1;
+        let (c0, c1) = (self.cum[k], self.cum[k + 1]);
+        let t = if c1 > c0 {
+            ((x - c0) / (c1 - c0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        self.grading.diameter_at((k as f64 + t) / n as f64)
+    }
 }
 
 #[cfg(test)]

@@ -16,8 +16,8 @@
 //!   and slots much denser) and [`PackParams::seed`] (the text's literal
 //!   configuration);
 //! * [`Grading`]: sieve curves with semi-log inverse-transform sampling
-//!   (§4.2.1), constant, uniform, mixtures (Table 4.1); [`estimate_count`]
-//!   (Eq. 3-1);
+//!   (§4.2.1), constant, uniform, mixtures (Table 4.1), truncated
+//!   log-normal; [`estimate_count`] (Eq. 3-1);
 //! * [`Domain`]: rectangle, trapezoid (both orientations), circle, simple
 //!   polygon (self-intersections rejected), fracture slot;
 //! * [`SpatialIndex`] with [`CellGrid`] (default, fastest) and the seed's
@@ -25,6 +25,12 @@
 //! * metrics: [`porosity`] (Eq. 4-2), [`porosity_in_window`],
 //!   [`check_packing`] (independent brute-force overlap/containment check,
 //!   contacts, coordination number, minimum gap);
+//! * 3D sphere packings ([`Sphere`] in a [`Container`]: box, periodic
+//!   box, cylinder, closed mesh) and their metrics: [`check_spheres`]
+//!   (independent cell-grid overlap and containment check, contacts,
+//!   coordination), [`solid_fraction`], [`core_solid_fraction`] (exact for
+//!   boxes and cylinders), [`radial_profile`] of a cylindrical specimen and
+//!   [`grading_report`] (mass-based D10/D30/D60, Cu, Cc);
 //! * [`optimise_porosity`]: genetic porosity control (§4.1–4.2);
 //!   [`graded_layers`]: functionally graded property layers (§4.3);
 //! * writers: [`write_csv`], [`write_vtu`], [`write_lammps_data`],
@@ -99,8 +105,10 @@ pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };
 pub use pack3d::{
-    Container, LammpsData3, MeshContainer, Pack3Params, Pack3Stats, Packing3, Sphere, pack3d,
-    pack3d_seeded, pack3d_sizes, read_csv3, read_lammps_data3, read_vtu3, read_yade3, write_csv3,
+    Container, CoreFraction, GradingReport, GradingStats, LammpsData3, MeshContainer,
+    Pack3Params, Pack3Stats, Packing3, RadialBin, Sphere, SphereReport, check_spheres,
+    core_solid_fraction, grading_report, pack3d, pack3d_seeded, pack3d_sizes, radial_profile,
+    read_csv3, read_lammps_data3, read_vtu3, read_yade3, solid_fraction, write_csv3,
     write_lammps_data3, write_vtu3, write_yade3,
 };
 pub use packer::{

@@ -72,11 +72,16 @@
 
 mod container;
 mod io;
+mod metrics;
 
 pub use container::{Container, MeshContainer};
 pub use io::{
     LammpsData3, read_csv3, read_lammps_data3, read_vtu3, read_yade3, write_csv3,
     write_lammps_data3, write_vtu3, write_yade3,
+};
+pub use metrics::{
+    CoreFraction, GradingReport, GradingStats, RadialBin, SphereReport, check_spheres,
+    core_solid_fraction, grading_report, radial_profile, solid_fraction,
 };
 
 use nalgebra::Point3;

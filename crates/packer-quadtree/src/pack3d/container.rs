@@ -30,9 +30,8 @@ impl MeshContainer {
     /// A mesh oriented inwards (negative signed volume) is flipped.
     ///
     /// # Errors
-    /// [`Error::Mesh`](crate::Error::Mesh) naming the first open or
-    /// non-manifold edge or the degenerate triangle;
-    /// [`Error::NonPositive`](crate::Error::NonPositive) for a zero volume.
+    /// [`Error::Mesh`](crate::Error::Mesh) naming the first open or non-manifold edge or the
+    /// degenerate triangle; [`Error::NonPositive`](crate::Error::NonPositive) for a zero volume.
     pub fn new(mesh: TriMesh) -> Result<Self> {
         let mut mesh = mesh;
         mesh.check_closed()?;
