@@ -578,19 +578,12 @@ impl<'a> Front3<'a> {
         }
         let tol = self.tol;
         let xs = &self.xs;
-        let mut ok = true;
-        self.grid.for_each_near(p, r + self.r_max, |id, s| {
-            if !ok {
-                return;
-            }
+        !self.grid.any_near(p, r + self.r_max, |id, s| {
             let o = xs[id as usize];
             let (dx, dy, dz) = (p[0] - o[0] - s[0], p[1] - o[1] - s[1], p[2] - o[2] - s[2]);
             let m = r + o[3] - tol;
-            if dx * dx + dy * dy + dz * dz < m * m {
-                ok = false;
-            }
-        });
-        ok
+            dx * dx + dy * dy + dz * dz < m * m
+        })
     }
 
     /// The first sphere: as low as possible, touching walls.
@@ -1102,13 +1095,17 @@ impl<'a> Front3<'a> {
                     }
                 }
             }
-            // The oldest size of the window that fits.
+            // The oldest size of the window that fits. A size the local
+            // test admits but the full index refuses (a sphere beyond the
+            // gathered reach) lowers the capacity below it, so the site
+            // cannot come back for the same sizes.
             let mut placed = false;
             for i in 0..window.len() {
                 let r = window[i];
-                if r <= lo
-                    && let Some(p) = self.try_site(&site, r)
-                {
+                if r > lo {
+                    continue;
+                }
+                if let Some(p) = self.try_site(&site, r) {
                     self.place_and_generate(p, r, &mut sites, g_of(order), &gkey);
                     skips = 0;
                     window.remove(i);
@@ -1116,6 +1113,11 @@ impl<'a> Front3<'a> {
                     placed = true;
                     break;
                 }
+                lo = r * (1.0 - 1e-9);
+            }
+            if !placed && lo < self.r_min {
+                self.stats.fronts_removed += 1;
+                continue;
             }
             if !placed {
                 sites.push(Site { cap: lo, ..site });

@@ -86,6 +86,16 @@ impl Grid3 {
     /// offset to add to the point's stored position.
     #[inline]
     pub(crate) fn for_each_near(&self, p: &[f64; 3], reach: f64, mut visit: impl FnMut(u32, [f64; 3])) {
+        self.any_near(p, reach, |id, s| {
+            visit(id, s);
+            false
+        });
+    }
+
+    /// As [`Grid3::for_each_near`], stopping at the first point for which
+    /// `hit` returns `true`; returns whether one did.
+    #[inline]
+    pub(crate) fn any_near(&self, p: &[f64; 3], reach: f64, mut hit: impl FnMut(u32, [f64; 3]) -> bool) -> bool {
         if !self.any_periodic {
             let lo = [
                 self.coord(0, p[0] - reach),
@@ -103,13 +113,15 @@ impl Grid3 {
                     for c in &self.head[row + lo[0]..=row + hi[0]] {
                         let mut id = *c;
                         while id != NIL {
-                            visit(id, [0.0; 3]);
+                            if hit(id, [0.0; 3]) {
+                                return true;
+                            }
                             id = self.next[id as usize];
                         }
                     }
                 }
             }
-            return;
+            return false;
         }
         let mut lo = [0i64; 3];
         let mut hi = [0i64; 3];
@@ -135,12 +147,15 @@ impl Grid3 {
                     let (cx, sx) = self.wrap(0, ix);
                     let mut id = self.head[row + cx];
                     while id != NIL {
-                        visit(id, [sx, sy, sz]);
+                        if hit(id, [sx, sy, sz]) {
+                            return true;
+                        }
                         id = self.next[id as usize];
                     }
                 }
             }
         }
+        false
     }
 
     #[inline]
