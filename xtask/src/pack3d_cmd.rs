@@ -89,7 +89,10 @@ pub(crate) fn parse_container(s: &str, root: &Path) -> anyhow::Result<Container>
             }
             .with_context(|| format!("reading {}", path.display()))?;
             let (mesh, _) = mesh.prepare_closed(Orientation::Repair).with_context(|| {
-                format!("the container mesh {} is not a closed surface", path.display())
+                format!(
+                    "the container mesh {} is not a closed surface",
+                    path.display()
+                )
             })?;
             Container::mesh(mesh).with_context(|| format!("container mesh {}", path.display()))?
         }
@@ -121,7 +124,10 @@ impl Run3<'_> {
             },
         };
         if !(self.density.is_finite() && self.density > 0.0) {
-            bail!("--density must be positive and finite, got {}", self.density);
+            bail!(
+                "--density must be positive and finite, got {}",
+                self.density
+            );
         }
         let t_setup = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
@@ -146,7 +152,12 @@ impl Run3<'_> {
                 }
                 Output::Lammps => {
                     let mut b = Vec::new();
-                    packer_quadtree::write_lammps_data3(&p.spheres, &container, self.density, &mut b)?;
+                    packer_quadtree::write_lammps_data3(
+                        &p.spheres,
+                        &container,
+                        self.density,
+                        &mut b,
+                    )?;
                     ("packing.data", b)
                 }
                 Output::Yade => {
@@ -197,7 +208,11 @@ struct Report {
     text: String,
 }
 
-fn metrics_report(container: &Container, grading: &Grading, p: &Packing3) -> anyhow::Result<Report> {
+fn metrics_report(
+    container: &Container,
+    grading: &Grading,
+    p: &Packing3,
+) -> anyhow::Result<Report> {
     let mut text = String::new();
     let d_max = grading.d_max();
     let check = packer_quadtree::check_spheres(container, &p.spheres, 1e-9)?;
@@ -266,11 +281,17 @@ mod tests {
         let root = Path::new(".");
         assert!(matches!(
             parse_container("box:40,40,40", root),
-            Ok(Container::Box { periodic: [false, false], .. })
+            Ok(Container::Box {
+                periodic: [false, false],
+                ..
+            })
         ));
         assert!(matches!(
             parse_container("box:40,40,40,periodic", root),
-            Ok(Container::Box { periodic: [true, true], .. })
+            Ok(Container::Box {
+                periodic: [true, true],
+                ..
+            })
         ));
         match parse_container("cylinder:20", root) {
             Ok(Container::Cylinder { radius, height, .. }) => {
@@ -278,7 +299,13 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
-        for bad in ["box:1,2", "cylinder:", "cylinder:1,2,3", "sphere:3", "mesh:/nonexistent.stl"] {
+        for bad in [
+            "box:1,2",
+            "cylinder:",
+            "cylinder:1,2,3",
+            "sphere:3",
+            "mesh:/nonexistent.stl",
+        ] {
             assert!(parse_container(bad, root).is_err(), "{bad}");
         }
     }

@@ -314,9 +314,9 @@ pub(crate) fn parse_grading(s: &str) -> anyhow::Result<Grading> {
             }
             Grading::Sieve { sizes, passing }
         }
-        _ => bail!(
-            "unknown grading `{kind}` (pinto-3.4, ap5, constant, uniform, lognormal, sieve)"
-        ),
+        _ => {
+            bail!("unknown grading `{kind}` (pinto-3.4, ap5, constant, uniform, lognormal, sieve)")
+        }
     };
     g.validate()?;
     Ok(g)

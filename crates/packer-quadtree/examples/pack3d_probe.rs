@@ -22,7 +22,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dmax = grading.d_max();
     let c = Container::walled_box(Vector3::new(side, side, side));
     let params = Pack3Params {
-        lookahead: std::env::var("LA").ok().and_then(|s| s.parse().ok()).unwrap_or(8),
+        lookahead: std::env::var("LA")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(8),
         front_order: order,
         ..Pack3Params::default()
     };

@@ -662,7 +662,11 @@ impl<'a> Front3<'a> {
                     return;
                 }
                 let o = xs[id as usize];
-                let d = [o[0] + s[0] - cf[0], o[1] + s[1] - cf[1], o[2] + s[2] - cf[2]];
+                let d = [
+                    o[0] + s[0] - cf[0],
+                    o[1] + s[1] - cf[1],
+                    o[2] + s[2] - cf[2],
+                ];
                 let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                 let lim = q[3] + o[3] + 2.0 * r;
                 if dd <= lim * lim {
@@ -831,7 +835,11 @@ impl<'a> Front3<'a> {
             return true;
         }
         let tol = self.tol;
-        let start = if self.last_block < n { self.last_block } else { 0 };
+        let start = if self.last_block < n {
+            self.last_block
+        } else {
+            0
+        };
         for k in 0..n {
             let mut i = start + k;
             if i >= n {
@@ -946,11 +954,9 @@ impl<'a> Front3<'a> {
         let Some(c) = self.site_position(site, self.r_min) else {
             return false;
         };
-        let delta = self
-            .site_position(site, r)
-            .map_or(r - self.r_min, |q| {
-                ((q[0] - c[0]).powi(2) + (q[1] - c[1]).powi(2) + (q[2] - c[2]).powi(2)).sqrt()
-            });
+        let delta = self.site_position(site, r).map_or(r - self.r_min, |q| {
+            ((q[0] - c[0]).powi(2) + (q[1] - c[1]).powi(2) + (q[2] - c[2]).powi(2)).sqrt()
+        });
         let reach = r + self.r_max + delta;
         self.local.clear();
         let xs = &self.xs;
@@ -1241,7 +1247,14 @@ fn sphere_sphere_plane(a: &Nb, w: &Plane, rho_f2: f64, out: &mut Pts) {
 
 /// Front and two planes `n_i·y = o_i`.
 #[inline]
-fn sphere_two_planes(n1: &Vector3<f64>, o1: f64, n2: &Vector3<f64>, o2: f64, rho_f2: f64, out: &mut Pts) {
+fn sphere_two_planes(
+    n1: &Vector3<f64>,
+    o1: f64,
+    n2: &Vector3<f64>,
+    o2: f64,
+    rho_f2: f64,
+    out: &mut Pts,
+) {
     let u = n1.cross(n2);
     let uu = u.norm_squared();
     if !(uu > 1e-20) {
@@ -1306,7 +1319,11 @@ fn circle_cylinder(a: &Nb, rho_f2: f64, ax: [f64; 2], rr: f64, out: &mut Pts) {
     }
     let s = s2.sqrt();
     let m = u * t;
-    let helper = if u.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let helper = if u.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
     let e1 = u.cross(&helper).normalize();
     let e2 = u.cross(&e1);
     let at = |th: f64| -> Vector3<f64> { m + (e1 * th.cos() + e2 * th.sin()) * s };

@@ -72,7 +72,8 @@ impl Grid3 {
 
     /// Inserts `id` (ids dense and increasing) at `p`.
     pub(crate) fn insert(&mut self, id: u32, p: &[f64; 4]) {
-        let c = self.coord(0, p[0]) + self.n[0] * (self.coord(1, p[1]) + self.n[1] * self.coord(2, p[2]));
+        let c = self.coord(0, p[0])
+            + self.n[0] * (self.coord(1, p[1]) + self.n[1] * self.coord(2, p[2]));
         let id_us = id as usize;
         if self.next.len() <= id_us {
             self.next.resize(id_us + 1, NIL);
@@ -85,7 +86,12 @@ impl Grid3 {
     /// cube of half-side `reach` around `p`; `shift` is the periodic image
     /// offset to add to the point's stored position.
     #[inline]
-    pub(crate) fn for_each_near(&self, p: &[f64; 3], reach: f64, mut visit: impl FnMut(u32, [f64; 3])) {
+    pub(crate) fn for_each_near(
+        &self,
+        p: &[f64; 3],
+        reach: f64,
+        mut visit: impl FnMut(u32, [f64; 3]),
+    ) {
         self.any_near(p, reach, |id, s| {
             visit(id, s);
             false
@@ -95,7 +101,12 @@ impl Grid3 {
     /// As [`Grid3::for_each_near`], stopping at the first point for which
     /// `hit` returns `true`; returns whether one did.
     #[inline]
-    pub(crate) fn any_near(&self, p: &[f64; 3], reach: f64, mut hit: impl FnMut(u32, [f64; 3]) -> bool) -> bool {
+    pub(crate) fn any_near(
+        &self,
+        p: &[f64; 3],
+        reach: f64,
+        mut hit: impl FnMut(u32, [f64; 3]) -> bool,
+    ) -> bool {
         if !self.any_periodic {
             let lo = [
                 self.coord(0, p[0] - reach),

@@ -143,7 +143,10 @@ fn every_container_is_overlap_free() {
                 .map(|s| 4.0 / 3.0 * std::f64::consts::PI * s.radius.powi(3))
                 .sum::<f64>()
                 / c.volume();
-            println!("container {i}: n {} solid {solid:.3} worst {w:e}", p.spheres.len());
+            println!(
+                "container {i}: n {} solid {solid:.3} worst {w:e}",
+                p.spheres.len()
+            );
             assert!(w >= -1e-9, "container {i}: worst {w}");
             assert!(solid > 0.4, "container {i}: solid {solid}");
         }
@@ -157,8 +160,13 @@ fn periodic_box_wraps_centres_and_uses_images() {
         max: Point3::new(10.0, 10.0, 8.0),
         periodic: [true, true],
     };
-    let p = pack3d_seeded(&c, &Grading::Constant { diameter: 1.0 }, &Pack3Params::default(), 1)
-        .expect("pack");
+    let p = pack3d_seeded(
+        &c,
+        &Grading::Constant { diameter: 1.0 },
+        &Pack3Params::default(),
+        1,
+    )
+    .expect("pack");
     for s in &p.spheres {
         assert!((0.0..10.0).contains(&s.center.x) && (0.0..10.0).contains(&s.center.y));
     }
@@ -192,7 +200,10 @@ fn closed_forms_agree_with_contact3d() {
         if want.len() == 2 {
             assert_eq!(got.len(), 2);
             for w in &want {
-                let best = got.iter().map(|g| (g - w).norm()).fold(f64::INFINITY, f64::min);
+                let best = got
+                    .iter()
+                    .map(|g| (g - w).norm())
+                    .fold(f64::INFINITY, f64::min);
                 assert!(best < 1e-9, "{best}");
             }
             checked += 1;
@@ -249,7 +260,8 @@ fn golden_digest_for_one_and_two_threads() {
     assert_eq!((d1, e1), GOLDEN);
 }
 
-const GOLDEN: ((usize, u64), (usize, u64)) = ((466, 0x38e6_00da_1b6e_81f7), (532, 0x17f5_02bf_2265_7ea8));
+const GOLDEN: ((usize, u64), (usize, u64)) =
+    ((466, 0x38e6_00da_1b6e_81f7), (532, 0x17f5_02bf_2265_7ea8));
 
 #[test]
 fn bad_input_is_a_structured_error() {
@@ -287,12 +299,20 @@ fn bad_input_is_a_structured_error() {
         Grading::Uniform { min: 2.0, max: 1.0 },
         Grading::Constant { diameter: f64::NAN },
     ] {
-        assert!(pack3d_seeded(&c, &g, &Pack3Params::default(), 1).is_err(), "{g:?}");
+        assert!(
+            pack3d_seeded(&c, &g, &Pack3Params::default(), 1).is_err(),
+            "{g:?}"
+        );
     }
     // A count beyond memory (a unit mistake: metres of container, mm sizes).
     let huge = Container::walled_box(Vector3::new(1e4, 1e4, 1e4));
     assert!(matches!(
-        pack3d_seeded(&huge, &Grading::Constant { diameter: 1.0 }, &Pack3Params::default(), 1),
+        pack3d_seeded(
+            &huge,
+            &Grading::Constant { diameter: 1.0 },
+            &Pack3Params::default(),
+            1
+        ),
         Err(Error::TooManyParticles { .. })
     ));
     // Bad container geometry and parameters.

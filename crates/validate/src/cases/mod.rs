@@ -6,6 +6,7 @@ use crate::{Case, ExpectedFailure};
 mod cloner;
 mod fixture_integrity;
 mod levelset;
+mod pack3d;
 mod packer_quadtree;
 pub mod parents;
 mod perez_morales;
@@ -19,6 +20,7 @@ pub fn registry() -> Vec<Case> {
     cases.extend(cloner::cases());
     cases.extend(fixture_integrity::cases());
     cases.extend(levelset::cases());
+    cases.extend(pack3d::cases());
     cases.extend(packer_quadtree::cases());
     cases.extend(parents::cases());
     cases.extend(perez_morales::cases());
@@ -33,6 +35,7 @@ pub fn expected_failures() -> Vec<ExpectedFailure> {
     list.extend_from_slice(cloner::EXPECTED_FAILURES);
     list.extend_from_slice(fixture_integrity::EXPECTED_FAILURES);
     list.extend_from_slice(levelset::EXPECTED_FAILURES);
+    list.extend_from_slice(pack3d::EXPECTED_FAILURES);
     list.extend_from_slice(packer_quadtree::EXPECTED_FAILURES);
     list.extend_from_slice(parents::EXPECTED_FAILURES);
     list.extend_from_slice(perez_morales::EXPECTED_FAILURES);
