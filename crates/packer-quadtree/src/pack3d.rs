@@ -124,6 +124,12 @@ pub struct Pack3Params {
     /// fill the last pockets under the lid with small spheres (denser,
     /// finer at the top).
     pub max_skips: usize,
+    /// Generate each new sphere's open sites on a second thread while the
+    /// next sphere is being placed (when rayon has at least two threads).
+    /// The sites of a sphere become available from the placement after
+    /// next (the lag-one rule, applied with or without the thread), so the
+    /// packing is the same for any thread count.
+    pub pipeline: bool,
     /// Upper bound on the number of spheres (guards against a unit mistake
     /// exhausting memory; checked against the estimate before any work).
     pub max_particles: usize,
@@ -135,6 +141,7 @@ impl Default for Pack3Params {
             front_order: FrontOrder::LowestCandidate,
             lookahead: 8,
             max_skips: 0,
+            pipeline: true,
             max_particles: 50_000_000,
         }
     }
@@ -235,7 +242,7 @@ pub fn pack3d(
         }
     }
     let est = (0.75 * 1.25 * container.volume() / mean_volume(grading)).ceil() + 64.0;
-    if !(est <= params.max_particles as f64) {
+    if !est.le(&(params.max_particles as f64)) {
         return Err(Error::TooManyParticles {
             estimate: est,
             limit: params.max_particles,
@@ -322,6 +329,7 @@ pub fn pack3d_sizes(
                 params.max_particles,
                 params.lookahead,
                 params.max_skips,
+                params.pipeline && orders.len() == 1,
             );
             let stats = f.stats;
             Packing3 {

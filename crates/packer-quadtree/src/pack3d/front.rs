@@ -16,8 +16,13 @@
 //! placement (the size is kept for the other fronts, as in 2D). A size that
 //! no front can take is skipped (counted in [`Pack3Stats::sizes_skipped`]).
 
+// Coordinates are `[f64; 3]` triples indexed in step with box bounds,
+// periods and cell counts: index loops read better than zipped iterators.
+#![allow(clippy::needless_range_loop)]
+
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
+use std::sync::mpsc;
 
 use nalgebra::{Point3, Vector3};
 
@@ -64,6 +69,7 @@ pub(crate) struct Plane {
 }
 
 /// Walls of the container as the front sees them.
+#[derive(Clone)]
 pub(crate) enum Walls {
     /// Box walls (up to six planes; periodic sides have none).
     Planes(Vec<Plane>),
@@ -78,6 +84,7 @@ pub(crate) enum Walls {
     Mesh(MeshWalls),
 }
 
+#[derive(Clone)]
 pub(crate) struct MeshWalls {
     lo: [f64; 3],
     inv: f64,
@@ -95,7 +102,7 @@ impl MeshWalls {
         let mut mul = 1;
         for k in 0..3 {
             let f = (p[k] - self.lo[k]) * self.inv;
-            if !(f >= 0.0) {
+            if !f.ge(&0.0) {
                 return None;
             }
             let i = f as usize;
@@ -337,6 +344,8 @@ struct Site {
     g: f64,
     /// Largest radius known to fit (infinite until a size failed here).
     cap: f64,
+    /// Registry slot (liveness and the site grid).
+    slot: u32,
 }
 impl PartialEq for Site {
     fn eq(&self, o: &Self) -> bool {
@@ -363,11 +372,79 @@ impl Ord for Site {
 /// Sites of one generation closer than `DEDUP · r_min` are one pocket.
 const DEDUP: f64 = 1.0;
 
+/// A new sphere kills the sites whose smallest-size centre lies within
+/// `KILL · (r + r_min)` of its centre.
+const KILL: f64 = 1.0;
+
 /// Bisection steps of a site's capacity.
 const BISECTIONS: usize = 4;
 
-/// `()` placeholder keeping the call sites readable.
-fn g_of(_order: FrontOrder) {}
+/// What happens to a popped site.
+#[derive(Clone, Copy, Debug)]
+enum Outcome {
+    /// Killed by a later sphere: retired without a test.
+    Dead,
+    /// No room even for the smallest size: retired.
+    Drop,
+    /// Too small for the window: back in the queue with this capacity.
+    Defer(f64),
+    /// Window entry `i` (radius `r`) goes to `p`.
+    Place { p: [f64; 3], r: f64, i: usize },
+}
+
+/// A message to the site-generation worker.
+enum Job {
+    /// Insert a placed sphere `[x, y, z, r]` into the replica.
+    Place([f64; 4]),
+    /// Generate the open sites of sphere `id` (secondary key `g`).
+    Generate(u32, f64),
+}
+
+/// The channels to the worker.
+struct Pipe {
+    jobs: mpsc::Sender<Job>,
+    results: mpsc::Receiver<Vec<Site>>,
+}
+
+impl Pipe {
+    fn send(&self, job: Job) {
+        // A failed send means the worker is gone; the receive below then
+        // reports an empty batch and the packing ends early but valid.
+        let _ = self.jobs.send(job);
+    }
+    fn receive(&self) -> Vec<Site> {
+        spin_receive(&self.results).unwrap_or_default()
+    }
+}
+
+/// Receives with a short spin before blocking (the two threads hand work
+/// to each other every few microseconds; parking costs more than that).
+fn spin_receive<T>(rx: &mpsc::Receiver<T>) -> Option<T> {
+    for i in 0..20_000u32 {
+        match rx.try_recv() {
+            Ok(x) => return Some(x),
+            Err(mpsc::TryRecvError::Disconnected) => return None,
+            Err(mpsc::TryRecvError::Empty) => {
+                if i % 64 == 63 {
+                    std::thread::yield_now();
+                } else {
+                    std::hint::spin_loop();
+                }
+            }
+        }
+    }
+    rx.recv().ok()
+}
+
+/// The open sites with the lag-one rule's pending sphere.
+struct Lag<'p> {
+    sites: Sites,
+    /// The last placed sphere, whose sites are not merged yet.
+    pending: Option<(u32, f64)>,
+    pipe: Option<Pipe>,
+    #[allow(dead_code)]
+    marker: std::marker::PhantomData<&'p ()>,
+}
 
 /// Number of capacity levels of the waiting sites.
 const LEVELS: usize = 16;
@@ -383,15 +460,164 @@ struct Sites {
     r_min: f64,
     step: f64,
     len: usize,
+    /// Per slot: alive (not overlapped by a later sphere at its
+    /// smallest-size centre) and its site-grid cell.
+    alive: Vec<bool>,
+    cell_of: Vec<u32>,
+    free: Vec<u32>,
+    grid: SiteGrid,
+}
+
+/// Open sites by their smallest-size centre, so that a new sphere kills
+/// the sites it overlaps at once (instead of two failed tests each when
+/// they come up).
+struct SiteGrid {
+    lo: [f64; 3],
+    inv: f64,
+    n: [usize; 3],
+    period: [f64; 2],
+    cells: Vec<Vec<(u32, [f64; 3])>>,
+}
+
+impl SiteGrid {
+    fn new(lo: [f64; 3], hi: [f64; 3], cell: f64, periodic: [bool; 2]) -> Self {
+        let mut c = cell;
+        while (0..3)
+            .map(|k| ((hi[k] - lo[k]) / c).ceil().max(1.0))
+            .product::<f64>()
+            > 16.0e6
+        {
+            c *= 1.25;
+        }
+        let n = [0, 1, 2].map(|k| (((hi[k] - lo[k]) / c).ceil() as usize).max(1));
+        let period = [
+            if periodic[0] { hi[0] - lo[0] } else { 0.0 },
+            if periodic[1] { hi[1] - lo[1] } else { 0.0 },
+        ];
+        Self {
+            lo,
+            inv: 1.0 / c,
+            n,
+            period,
+            cells: vec![Vec::new(); n[0] * n[1] * n[2]],
+        }
+    }
+    /// Wraps periodic coordinates into the box.
+    fn wrap(&self, mut p: [f64; 3]) -> [f64; 3] {
+        for k in 0..2 {
+            let l = self.period[k];
+            if l > 0.0 {
+                p[k] -= ((p[k] - self.lo[k]) / l).floor() * l;
+            }
+        }
+        p
+    }
+    fn index(&self, k: usize, x: f64) -> i64 {
+        ((x - self.lo[k]) * self.inv).floor() as i64
+    }
+    fn cell(&self, p: &[f64; 3]) -> usize {
+        let i = [0, 1, 2].map(|k| self.index(k, p[k]).clamp(0, self.n[k] as i64 - 1) as usize);
+        i[0] + self.n[0] * (i[1] + self.n[1] * i[2])
+    }
 }
 
 impl Sites {
-    fn new(r_min: f64, r_max: f64) -> Self {
+    /// Registers a new site and queues it.
+    fn add(&mut self, mut s: Site) {
+        let slot = match self.free.pop() {
+            Some(x) => x,
+            None => {
+                self.alive.push(false);
+                self.cell_of.push(0);
+                (self.alive.len() - 1) as u32
+            }
+        };
+        let p = self.grid.wrap(s.k);
+        let c = self.grid.cell(&p);
+        self.grid.cells[c].push((slot, p));
+        self.alive[slot as usize] = true;
+        self.cell_of[slot as usize] = c as u32;
+        s.slot = slot;
+        self.push(s);
+    }
+    fn is_alive(&self, slot: u32) -> bool {
+        self.alive[slot as usize]
+    }
+    /// Removes a popped site for good.
+    fn retire(&mut self, slot: u32) {
+        let i = slot as usize;
+        if self.alive[i] {
+            let cell = &mut self.grid.cells[self.cell_of[i] as usize];
+            if let Some(pos) = cell.iter().position(|e| e.0 == slot) {
+                cell.swap_remove(pos);
+            }
+            self.alive[i] = false;
+        }
+        self.free.push(slot);
+    }
+    /// Kills every site whose smallest-size sphere overlaps the sphere
+    /// `(c, r)`; returns how many.
+    fn kill_near(&mut self, c: &[f64; 3], r: f64, r_min: f64, tol: f64) -> u64 {
+        let reach = r + r_min;
+        let lim = (KILL * reach - tol).max(0.0);
+        let lim2 = lim * lim;
+        let g = &mut self.grid;
+        let mut lo = [0i64; 3];
+        let mut hi = [0i64; 3];
+        for k in 0..3 {
+            lo[k] = g.index(k, c[k] - reach);
+            hi[k] = g.index(k, c[k] + reach);
+            let periodic = k < 2 && g.period[k] > 0.0;
+            if periodic {
+                hi[k] = hi[k].min(lo[k] + g.n[k] as i64 - 1);
+            } else {
+                lo[k] = lo[k].max(0);
+                hi[k] = hi[k].min(g.n[k] as i64 - 1);
+            }
+        }
+        let mut killed = 0;
+        for iz in lo[2]..=hi[2] {
+            for iy in lo[1]..=hi[1] {
+                for ix in lo[0]..=hi[0] {
+                    let w = |k: usize, i: i64| i.rem_euclid(g.n[k] as i64) as usize;
+                    let idx = w(0, ix) + g.n[0] * (w(1, iy) + g.n[1] * iz as usize);
+                    let cell = &mut g.cells[idx];
+                    let mut j = 0;
+                    while j < cell.len() {
+                        let (slot, p) = cell[j];
+                        let mut d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+                        for k in 0..2 {
+                            let l = g.period[k];
+                            if l > 0.0 {
+                                d[k] -= (d[k] / l).round() * l;
+                            }
+                        }
+                        if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < lim2 {
+                            cell.swap_remove(j);
+                            self.alive[slot as usize] = false;
+                            killed += 1;
+                        } else {
+                            j += 1;
+                        }
+                    }
+                }
+            }
+        }
+        killed
+    }
+}
+
+impl Sites {
+    fn new(r_min: f64, r_max: f64, lo: [f64; 3], hi: [f64; 3], periodic: [bool; 2]) -> Self {
         Self {
             heaps: (0..=LEVELS).map(|_| BinaryHeap::new()).collect(),
             r_min,
             step: (r_max - r_min) / LEVELS as f64,
             len: 0,
+            alive: Vec::new(),
+            cell_of: Vec::new(),
+            free: Vec::new(),
+            grid: SiteGrid::new(lo, hi, 2.0 * r_max, periodic),
         }
     }
     /// Capacity of level `j`.
@@ -413,7 +639,11 @@ impl Sites {
         (((cap - self.r_min) / self.step).floor().max(0.0) as usize).min(LEVELS - 1)
     }
     fn push(&mut self, s: Site) {
-        let j = self.level(s.cap);
+        let mut j = self.level(s.cap);
+        // A capacity that is exactly a level's (a site put back) stays in it.
+        if j < LEVELS && self.cap(j + 1) <= s.cap {
+            j += 1;
+        }
         let cap = self.cap(j);
         self.heaps[j].push(Site { cap, ..s });
         self.len += 1;
@@ -434,6 +664,26 @@ impl Sites {
         let (j, _) = best?;
         self.len -= 1;
         self.heaps[j].pop()
+    }
+    /// The site [`Sites::pop_for`] would return, without removing it.
+    fn peek_for(&self, r: f64) -> Option<&Site> {
+        let mut best: Option<&Site> = None;
+        for j in (0..=LEVELS).rev() {
+            if self.cap(j) < r * (1.0 - 1e-12) {
+                break;
+            }
+            if let Some(t) = self.heaps[j].peek()
+                && best.is_none_or(|b| t > b)
+            {
+                best = Some(t);
+            }
+        }
+        best
+    }
+    /// Puts a popped site back unchanged (its capacity is already a level
+    /// capacity).
+    fn push_back(&mut self, s: Site) {
+        self.push(s);
     }
     /// Whether any site waits.
     fn is_empty(&self) -> bool {
@@ -459,6 +709,7 @@ struct Nb {
     id: u32,
 }
 
+#[derive(Clone)]
 pub(crate) struct Front3<'a> {
     container: &'a Container,
     walls: Walls,
@@ -479,6 +730,8 @@ pub(crate) struct Front3<'a> {
     local: Vec<[f64; 4]>,
     /// Feasible sites of one generation.
     kept: Vec<([f64; 3], u32, u32)>,
+    /// Sites of one placement (sequential mode).
+    batch: Vec<Site>,
     last_block: usize,
     pub(crate) stats: Pack3Stats,
 }
@@ -511,6 +764,7 @@ impl<'a> Front3<'a> {
             cands: Vec::with_capacity(1024),
             local: Vec::with_capacity(128),
             kept: Vec::with_capacity(64),
+            batch: Vec::with_capacity(64),
             last_block: 0,
             stats: Pack3Stats::default(),
         }
@@ -645,7 +899,7 @@ impl<'a> Front3<'a> {
     /// Open sites of the new sphere `f` for the smallest size: the common
     /// points of its halo with two more halos or offset walls that are
     /// inside the container and outside every halo.
-    fn generate(&mut self, f: u32, g: f64, out: &mut Sites) {
+    fn generate(&mut self, f: u32, g: f64, out: &mut Vec<Site>) {
         self.stats.evaluations += 1;
         let r = self.r_min;
         let q = self.xs[f as usize];
@@ -819,6 +1073,7 @@ impl<'a> Front3<'a> {
                 ids: [f, a, b],
                 g,
                 cap: f64::INFINITY,
+                slot: 0,
             });
         }
         cands.clear();
@@ -1001,6 +1256,7 @@ impl<'a> Front3<'a> {
         max: usize,
         lookahead: usize,
         max_skips: usize,
+        pipeline: bool,
     ) {
         let mut k = 0usize;
         let first = loop {
@@ -1022,128 +1278,307 @@ impl<'a> Front3<'a> {
             FrontOrder::Stack => -f64::from(id),
             _ => 0.0,
         };
-        let mut sites = Sites::new(self.r_min, self.r_max);
+        let (blo, bhi) = self.container.bbox();
+        let mut sites = Sites::new(
+            self.r_min,
+            self.r_max,
+            [blo.x, blo.y, blo.z],
+            [bhi.x, bhi.y, bhi.z],
+            self.periodic,
+        );
         let g = gkey(self, first);
-        self.generate(first, g, &mut sites);
+        let mut batch = Vec::new();
+        self.generate(first, g, &mut batch);
+        for st in batch.drain(..) {
+            sites.add(st);
+        }
         if sites.is_empty()
             && let Some(floor) = self.all_planes.iter().position(|w| w.n[2] > 0.999_999)
         {
             // Periodic in x and y: nothing but the floor around the first
             // sphere; the second one sits beside it.
             let q = self.xs[first as usize];
-            sites.push(Site {
+            sites.add(Site {
                 k: [q[0] + q[3] + self.r_min, q[1], q[2]],
                 ids: [first, WALL + floor as u32, FREE],
                 g,
                 cap: f64::INFINITY,
+                slot: 0,
             });
         }
-        // The window of upcoming radii, oldest first.
-        let w = lookahead.max(1);
-        let mut window: Vec<f64> = Vec::with_capacity(w);
-        let mut refill = |window: &mut Vec<f64>, k: &mut usize, st: &mut Pack3Stats| {
-            while window.len() < w {
-                let Some(d) = sizes(*k) else { break };
-                *k += 1;
-                st.sizes_drawn += 1;
-                window.push(0.5 * d);
-            }
-        };
-        refill(&mut window, &mut k, &mut self.stats);
-        let mut skips = 0usize;
-        let mut peak = 0usize;
-        while self.xs.len() < max && !window.is_empty() {
-            let r_small = window.iter().copied().fold(f64::INFINITY, f64::min);
-            let Some(site) = sites.pop_for(r_small) else {
-                if sites.is_empty() || skips >= max_skips {
-                    break;
+        let mut main = |this: &mut Self, lag: &mut Lag<'_>| {
+            // The window of upcoming radii, oldest first.
+            let w = lookahead.max(1);
+            let mut window: Vec<f64> = Vec::with_capacity(w);
+            let mut refill = |window: &mut Vec<f64>, k: &mut usize, st: &mut Pack3Stats| {
+                while window.len() < w {
+                    let Some(d) = sizes(*k) else { break };
+                    *k += 1;
+                    st.sizes_drawn += 1;
+                    window.push(0.5 * d);
                 }
-                // No site takes any size of the window: skip the oldest.
-                self.stats.sizes_skipped += 1;
-                skips += 1;
-                window.remove(0);
-                refill(&mut window, &mut k, &mut self.stats);
-                continue;
             };
-            self.stats.pops += 1;
-            let r0 = window[0];
-            if site.cap >= r0
-                && let Some(p) = self.try_site(&site, r0)
-            {
-                self.place_and_generate(p, r0, &mut sites, g_of(order), &gkey);
-                skips = 0;
-                window.remove(0);
-                refill(&mut window, &mut k, &mut self.stats);
-                peak = peak.max(sites.len());
-                continue;
-            }
-            if self.try_site(&site, self.r_min).is_none() {
-                self.stats.fronts_removed += 1;
-                continue;
-            }
-            // Capacity by bisection on [r_min, min(r0, cap)] to 1/16,
-            // against the spheres gathered once.
-            let top = r0.min(site.cap);
-            if !self.gather_local(&site, top) {
-                self.stats.fronts_removed += 1;
-                continue;
-            }
-            let (mut lo, mut hi) = (self.r_min, top);
-            if self.try_local(&site, hi) {
-                lo = hi;
-            } else {
-                for _ in 0..BISECTIONS {
-                    let mid = 0.5 * (lo + hi);
-                    if self.try_local(&site, mid) {
-                        lo = mid;
-                    } else {
-                        hi = mid;
+            refill(&mut window, &mut k, &mut this.stats);
+            let mut skips = 0usize;
+            let mut peak = 0usize;
+            let mut spec: Vec<(Site, Outcome)> = Vec::new();
+            let mut cache: Vec<(u32, Outcome)> = Vec::new();
+            while this.xs.len() < max && !window.is_empty() {
+                let r_small = window.iter().copied().fold(f64::INFINITY, f64::min);
+                if lag.pending.is_some() {
+                    // The worker generates the last sphere's sites: decide
+                    // the next pops meanwhile (read-only), then replay them
+                    // in the exact sequential order once the sites are in.
+                    spec.clear();
+                    let mut ready: Option<Vec<Site>> = None;
+                    loop {
+                        // Speculate only while the worker is busy: the
+                        // replay gives the same packing however far we got.
+                        if let Some(pipe) = &lag.pipe
+                            && let Ok(b) = pipe.results.try_recv()
+                        {
+                            ready = Some(b);
+                            break;
+                        }
+                        let Some(site) = lag.sites.pop_for(r_small) else {
+                            break;
+                        };
+                        let o = if lag.sites.is_alive(site.slot) {
+                            this.decide(&site, &window)
+                        } else {
+                            Outcome::Dead
+                        };
+                        let stop = matches!(o, Outcome::Place { .. });
+                        spec.push((site, o));
+                        if stop {
+                            break;
+                        }
                     }
-                }
-            }
-            // The oldest size of the window that fits. A size the local
-            // test admits but the full index refuses (a sphere beyond the
-            // gathered reach) lowers the capacity below it, so the site
-            // cannot come back for the same sizes.
-            let mut placed = false;
-            for i in 0..window.len() {
-                let r = window[i];
-                if r > lo {
+                    this.merge_pending(lag, ready);
+                    let mut iter = std::mem::take(&mut spec).into_iter();
+                    while let Some((site, o)) = iter.next() {
+                        if lag.sites.peek_for(r_small).is_some_and(|t| t > &site) {
+                            // A new site is lower: the sequential loop would
+                            // have taken it first.
+                            lag.sites.push_back(site);
+                            cache.push((site.slot, o));
+                            for (rest, ro) in iter.by_ref() {
+                                lag.sites.push_back(rest);
+                                cache.push((rest.slot, ro));
+                            }
+                            break;
+                        }
+                        if this.apply(site, o, lag, &mut window, &gkey) {
+                            skips = 0;
+                            cache.clear();
+                            refill(&mut window, &mut k, &mut this.stats);
+                        }
+                    }
+                    peak = peak.max(lag.sites.len());
                     continue;
                 }
-                if let Some(p) = self.try_site(&site, r) {
-                    self.place_and_generate(p, r, &mut sites, g_of(order), &gkey);
+                let Some(site) = lag.sites.pop_for(r_small) else {
+                    if lag.sites.is_empty() || skips >= max_skips {
+                        break;
+                    }
+                    // No site takes any size of the window: skip the oldest.
+                    this.stats.sizes_skipped += 1;
+                    skips += 1;
+                    window.remove(0);
+                    refill(&mut window, &mut k, &mut this.stats);
+                    continue;
+                };
+                // A decision made while speculating still holds: nothing
+                // was placed since.
+                let cached = cache
+                    .iter()
+                    .position(|c| c.0 == site.slot)
+                    .map(|i| cache.swap_remove(i).1);
+                let o = match cached {
+                    Some(o) => o,
+                    None if lag.sites.is_alive(site.slot) => this.decide(&site, &window),
+                    None => Outcome::Dead,
+                };
+                if this.apply(site, o, lag, &mut window, &gkey) {
                     skips = 0;
-                    window.remove(i);
-                    refill(&mut window, &mut k, &mut self.stats);
-                    placed = true;
-                    break;
+                    cache.clear();
+                    refill(&mut window, &mut k, &mut this.stats);
                 }
-                lo = r * (1.0 - 1e-9);
+                peak = peak.max(lag.sites.len());
             }
-            if !placed && lo < self.r_min {
-                self.stats.fronts_removed += 1;
-                continue;
-            }
-            if !placed {
-                sites.push(Site { cap: lo, ..site });
-            }
-            peak = peak.max(sites.len());
+            this.merge_pending(lag, None);
+            this.note_memory(peak * std::mem::size_of::<Site>());
+        };
+        let threaded = pipeline && rayon::current_num_threads() >= 2;
+        if threaded {
+            let mut replica = self.clone();
+            replica.stats = Pack3Stats::default();
+            let (job_tx, job_rx) = mpsc::channel::<Job>();
+            let (res_tx, res_rx) = mpsc::channel::<Vec<Site>>();
+            let worker_stats = std::thread::scope(|scope| {
+                let worker = scope.spawn(move || {
+                    loop {
+                        match spin_receive(&job_rx) {
+                            Some(Job::Place(q)) => {
+                                replica.place([q[0], q[1], q[2]], q[3]);
+                            }
+                            Some(Job::Generate(id, g)) => {
+                                let mut b = Vec::new();
+                                replica.generate(id, g, &mut b);
+                                if res_tx.send(b).is_err() {
+                                    break;
+                                }
+                            }
+                            None => break,
+                        }
+                    }
+                    replica.stats
+                });
+                let mut lag = Lag {
+                    sites,
+                    pending: None,
+                    pipe: Some(Pipe {
+                        jobs: job_tx,
+                        results: res_rx,
+                    }),
+                    marker: std::marker::PhantomData,
+                };
+                main(self, &mut lag);
+                // Closing the job channel stops the worker.
+                drop(lag.pipe.take());
+                worker.join().unwrap_or_default()
+            });
+            self.stats.evaluations += worker_stats.evaluations;
+            self.stats.neighbours += worker_stats.neighbours;
+            self.stats.candidates += worker_stats.candidates;
+            self.stats.sites += worker_stats.sites;
+        } else {
+            let mut lag = Lag {
+                sites,
+                pending: None,
+                pipe: None,
+                marker: std::marker::PhantomData,
+            };
+            main(self, &mut lag);
         }
-        self.note_memory(peak * std::mem::size_of::<Site>());
     }
 
-    fn place_and_generate(
+    /// What the front does with a popped site for the current window
+    /// (reads the spheres, changes nothing but scratch and counters).
+    fn decide(&mut self, site: &Site, window: &[f64]) -> Outcome {
+        self.stats.pops += 1;
+        let r0 = window[0];
+        if site.cap >= r0
+            && let Some(p) = self.try_site(site, r0)
+        {
+            return Outcome::Place { p, r: r0, i: 0 };
+        }
+        if self.try_site(site, self.r_min).is_none() {
+            return Outcome::Drop;
+        }
+        // Capacity by bisection on [r_min, min(r0, cap)] to 1/16, against
+        // the spheres gathered once.
+        let top = r0.min(site.cap);
+        if !self.gather_local(site, top) {
+            return Outcome::Drop;
+        }
+        let (mut lo, mut hi) = (self.r_min, top);
+        if self.try_local(site, hi) {
+            lo = hi;
+        } else {
+            for _ in 0..BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                if self.try_local(site, mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+        }
+        // The oldest size of the window that fits. A size the local test
+        // admits but the full index refuses (a sphere beyond the gathered
+        // reach) lowers the capacity below it, so the site cannot come back
+        // for the same sizes.
+        for (i, &r) in window.iter().enumerate() {
+            if r > lo {
+                continue;
+            }
+            if let Some(p) = self.try_site(site, r) {
+                return Outcome::Place { p, r, i };
+            }
+            lo = r * (1.0 - 1e-9);
+        }
+        if lo < self.r_min {
+            Outcome::Drop
+        } else {
+            Outcome::Defer(lo)
+        }
+    }
+
+    /// Carries out a decision; returns whether a sphere was placed (the
+    /// window entry is then removed and must be refilled).
+    fn apply(
         &mut self,
-        p: [f64; 3],
-        r: f64,
-        sites: &mut Sites,
-        _g: (),
-        gkey: &dyn Fn(&Self, u32) -> f64,
-    ) {
-        let id = self.place(p, r);
-        let g = gkey(self, id);
-        self.generate(id, g, sites);
+        site: Site,
+        o: Outcome,
+        lag: &mut Lag<'_>,
+        window: &mut Vec<f64>,
+        g_of: &dyn Fn(&Self, u32) -> f64,
+    ) -> bool {
+        match o {
+            Outcome::Dead => {
+                lag.sites.retire(site.slot);
+                false
+            }
+            Outcome::Drop => {
+                self.stats.fronts_removed += 1;
+                lag.sites.retire(site.slot);
+                false
+            }
+            Outcome::Defer(lo) => {
+                lag.sites.push(Site { cap: lo, ..site });
+                false
+            }
+            Outcome::Place { p, r, i } => {
+                lag.sites.retire(site.slot);
+                let id = self.place(p, r);
+                let q = self.xs[id as usize];
+                self.stats.fronts_removed +=
+                    lag.sites
+                        .kill_near(&[q[0], q[1], q[2]], r, self.r_min, self.tol);
+                let g = g_of(self, id);
+                match &lag.pipe {
+                    Some(pipe) => {
+                        pipe.send(Job::Place(q));
+                        pipe.send(Job::Generate(id, g));
+                        lag.pending = Some((id, g));
+                    }
+                    None => {
+                        let mut b = std::mem::take(&mut self.batch);
+                        self.generate(id, g, &mut b);
+                        for st in b.drain(..) {
+                            lag.sites.add(st);
+                        }
+                        self.batch = b;
+                    }
+                }
+                window.remove(i);
+                true
+            }
+        }
+    }
+
+    /// Adds the pending sphere's sites (from the worker) to the open sites.
+    fn merge_pending(&mut self, lag: &mut Lag<'_>, ready: Option<Vec<Site>>) {
+        if lag.pending.take().is_none() {
+            return;
+        }
+        if let Some(pipe) = &lag.pipe {
+            let batch = ready.unwrap_or_else(|| pipe.receive());
+            for st in batch {
+                lag.sites.add(st);
+            }
+        }
     }
 
     fn note_memory(&mut self, extra: usize) {
@@ -1190,7 +1625,7 @@ fn three_spheres(a: &Nb, b: &Nb, rho_f2: f64, out: &mut Pts) {
         da[0] * db[1] - da[1] * db[0],
     ];
     let uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-    if !(uu > 1e-20 * a.dd * b.dd) {
+    if !uu.gt(&(1e-20 * a.dd * b.dd)) {
         return;
     }
     // y0 = ((d_b × u) b_a + (u × d_a) b_b) / |u|²
@@ -1228,7 +1663,7 @@ fn sphere_sphere_plane(a: &Nb, w: &Plane, rho_f2: f64, out: &mut Pts) {
     let da = Vector3::from(a.d);
     let u = da.cross(&w.n);
     let uu = u.norm_squared();
-    if !(uu > 1e-20 * a.dd) {
+    if !uu.gt(&(1e-20 * a.dd)) {
         return;
     }
     let y0 = (w.n.cross(&u) * a.b + u.cross(&da) * w.o) / uu;
@@ -1257,7 +1692,7 @@ fn sphere_two_planes(
 ) {
     let u = n1.cross(n2);
     let uu = u.norm_squared();
-    if !(uu > 1e-20) {
+    if !uu.gt(&1e-20) {
         return;
     }
     let y0 = (n2.cross(&u) * o1 + u.cross(n1) * o2) / uu;
