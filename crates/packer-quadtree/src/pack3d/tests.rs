@@ -261,7 +261,7 @@ fn golden_digest_for_one_and_two_threads() {
 }
 
 const GOLDEN: ((usize, u64), (usize, u64)) =
-    ((466, 0x38e6_00da_1b6e_81f7), (532, 0x17f5_02bf_2265_7ea8));
+    ((466, 0x6f4f_935c_56c8_1824), (533, 0x6759_eee0_f38e_adc3));
 
 #[test]
 fn bad_input_is_a_structured_error() {
