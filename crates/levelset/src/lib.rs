@@ -26,6 +26,10 @@
 //!   [`Grid::mass_properties_of`] integrates without walking the grid again (bit for bit
 //!   [`Grid::mass_properties`]).
 //! * LS-DEM contact: [`Body`], [`contact()`] / [`contact_into`] → [`NodeContact`].
+//! * Multi-sphere clumps for DEM codes without level sets: [`clump()`] ([`ClumpParams`],
+//!   [`VolumeCorrection`]) → [`Clump`] (CLUMP's distance-transform generator on φ, radii
+//!   grown to the grain's volume), [`clump_quality`] → [`ClumpQuality`] (volume, principal
+//!   moments and surface deviation of the union of the spheres), see [`clump`](mod@clump).
 //! * Labelled images (watershed-segmented CT scans): [`LabelImage`] (x fastest, 0 =
 //!   background, [`LabelImage::paint`] rasterises grids), [`LabelImage::extract`] →
 //!   [`Extraction`] (one level set per grain, [`ExtractParams`]: border exclusion,
@@ -80,9 +84,12 @@
 //! * Bærentzen & Aanæs 2005, IEEE TVCG 11, doi:10.1109/TVCG.2005.49 (pseudonormals).
 //! * Felzenszwalb & Huttenlocher 2012, Theory Comput. 8, doi:10.4086/toc.2012.v008a019 (EDT).
 //! * Lorensen & Cline 1987, doi:10.1145/37402.37422 (marching cubes).
+//! * Angelidakis, Nadimi, Otsubo, Utili 2021, SoftwareX 15, 100735,
+//!   doi:10.1016/j.softx.2021.100735 (CLUMP multi-sphere generators).
 //!
 //! Layer 0: no internal dependencies (see `docs/architecture.md`).
 
+pub mod clump;
 pub mod contact;
 mod crew;
 pub mod error;
@@ -101,6 +108,7 @@ pub mod voxel;
 /// Re-export of the vector vocabulary of the API, so callers need no separate pin.
 pub use nalgebra;
 
+pub use clump::{Clump, ClumpParams, ClumpQuality, VolumeCorrection, clump, clump_quality};
 pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};
 pub use grid::{Grid, GridSpec};
