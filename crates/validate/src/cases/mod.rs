@@ -11,6 +11,7 @@ mod packer_quadtree;
 pub mod parents;
 mod perez_morales;
 mod rounding;
+mod specimen;
 mod sph_harmonics;
 
 /// Every registered case, in a stable order.
@@ -24,6 +25,7 @@ pub fn registry() -> Vec<Case> {
     cases.extend(packer_quadtree::cases());
     cases.extend(parents::cases());
     cases.extend(perez_morales::cases());
+    cases.extend(specimen::cases());
     cases.extend(sph_harmonics::cases());
     cases
 }
@@ -39,6 +41,7 @@ pub fn expected_failures() -> Vec<ExpectedFailure> {
     list.extend_from_slice(packer_quadtree::EXPECTED_FAILURES);
     list.extend_from_slice(parents::EXPECTED_FAILURES);
     list.extend_from_slice(perez_morales::EXPECTED_FAILURES);
+    list.extend_from_slice(specimen::EXPECTED_FAILURES);
     list.extend_from_slice(sph_harmonics::EXPECTED_FAILURES);
     list
 }
