@@ -15,7 +15,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use levelset::Orientation;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
 use packer_quadtree::{Container, Grading, Pack3Params, Packing3};
 
 use crate::pack_cmd::{Output, Preset};
@@ -174,7 +174,7 @@ impl Run3<'_> {
             write_atomic(&root.join(path), bytes)?;
         }
         let t_write = t3.elapsed().as_secs_f64();
-        let mut text = report.text;
+        let mut text = report;
         let n = p.spheres.len() as f64;
         let _ = writeln!(
             text,
@@ -204,15 +204,11 @@ impl Run3<'_> {
 
 /// The checked metrics of a packing, as report text; an error when the
 /// independent checker finds an overlap.
-struct Report {
-    text: String,
-}
-
 fn metrics_report(
     container: &Container,
     grading: &Grading,
     p: &Packing3,
-) -> anyhow::Result<Report> {
+) -> anyhow::Result<String> {
     let mut text = String::new();
     let d_max = grading.d_max();
     let check = packer_quadtree::check_spheres(container, &p.spheres, 1e-9)?;
@@ -266,8 +262,7 @@ fn metrics_report(
          the passing curve {:.4}",
         g.packed.cu, g.requested.cu, g.packed.cc, g.requested.cc, g.max_deviation
     );
-    let _ = Vector3::<f64>::zeros();
-    Ok(Report { text })
+    Ok(text)
 }
 
 #[cfg(test)]

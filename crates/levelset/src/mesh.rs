@@ -634,6 +634,18 @@ enum Feature {
     Vertex(usize),
 }
 
+/// Unsigned distance from `p` to the triangle `abc` (Ericson 2005, Sec. 5.1.5).
+#[must_use]
+pub fn point_triangle_distance(
+    p: &Point3<f64>,
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    c: &Point3<f64>,
+) -> f64 {
+    let (q, _) = closest_on_triangle(&p.coords, &a.coords, &b.coords, &c.coords);
+    (p.coords - q).norm()
+}
+
 /// Ericson 2005, `ClosestPtPointTriangle` (Sec. 5.1.5), with the Voronoi region.
 #[inline]
 fn closest_on_triangle(

@@ -72,6 +72,13 @@ pub fn write_vtu(disks: &[Disk], mut w: impl Write) -> Result<()> {
     for d in disks {
         writeln!(w, "{:e} {:e} 0", d.center.x, d.center.y)?;
     }
+    write_vtu_vertex_cells(n, &mut w)
+}
+
+/// The end of a VTU of `n` points written as vertex cells: closes the
+/// points array, writes connectivity, offsets and types (VTK_VERTEX) and
+/// closes the file (shared by the 2D and 3D writers).
+pub(crate) fn write_vtu_vertex_cells(n: usize, w: &mut impl Write) -> Result<()> {
     writeln!(w, "</DataArray>")?;
     writeln!(w, "</Points>")?;
     writeln!(w, "<Cells>")?;

@@ -224,6 +224,24 @@ pub fn pack3d(
     grading.validate()?;
     params.validate()?;
     let (d_min, d_max) = (grading.d_min(), grading.d_max());
+    let inscribed = check_room(container, d_max)?;
+    let est = (0.75 * 1.25 * container.volume() / mean_volume(grading)).ceil() + 64.0;
+    if !est.le(&(params.max_particles as f64)) {
+        return Err(Error::TooManyParticles {
+            estimate: est,
+            limit: params.max_particles,
+        });
+    }
+    let sizes: Vec<f64> = (0..est as usize).map(|_| grading.sample(rng)).collect();
+    // Validated above: every drawn size lies in [d_min, d_max].
+    pack_checked(container, &sizes, d_min, d_max, inscribed, params)
+}
+
+/// The container holds a sphere of diameter `d_max`, and a periodic side is
+/// at least `4 d_max` (a sphere must not meet its own image through the
+/// index); returns the inscribed diameter (a lattice of exact clearances
+/// for meshes, so computed once per packing).
+fn check_room(container: &Container, d_max: f64) -> Result<f64> {
     let inscribed = container.inscribed_diameter();
     if inscribed < d_max {
         return Err(Error::DomainTooSmall {
@@ -241,15 +259,7 @@ pub fn pack3d(
             }
         }
     }
-    let est = (0.75 * 1.25 * container.volume() / mean_volume(grading)).ceil() + 64.0;
-    if !est.le(&(params.max_particles as f64)) {
-        return Err(Error::TooManyParticles {
-            estimate: est,
-            limit: params.max_particles,
-        });
-    }
-    let sizes: Vec<f64> = (0..est as usize).map(|_| grading.sample(rng)).collect();
-    pack3d_sizes(container, &sizes, d_min, d_max, params)
+    Ok(inscribed)
 }
 
 /// [`pack3d`] with a ChaCha8 generator seeded by `seed`.
@@ -296,19 +306,19 @@ pub fn pack3d_sizes(
         lo = lo.min(d);
         hi = hi.max(d);
     }
-    if params.max_particles < sizes.len().min(params.max_particles) {
-        return Err(Error::TooManyParticles {
-            estimate: sizes.len() as f64,
-            limit: params.max_particles,
-        });
-    }
-    let inscribed = container.inscribed_diameter();
-    if inscribed < hi {
-        return Err(Error::DomainTooSmall {
-            domain: inscribed,
-            particle: hi,
-        });
-    }
+    let inscribed = check_room(container, hi)?;
+    pack_checked(container, sizes, lo, hi, inscribed, params)
+}
+
+/// The packing proper, on validated input.
+fn pack_checked(
+    container: &Container,
+    sizes: &[f64],
+    lo: f64,
+    hi: f64,
+    inscribed: f64,
+    params: &Pack3Params,
+) -> Result<Packing3> {
     let orders: Vec<FrontOrder> = if params.front_order == FrontOrder::Best {
         vec![
             FrontOrder::LowestCandidate,

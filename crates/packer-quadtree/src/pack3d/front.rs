@@ -241,7 +241,9 @@ impl Walls {
                                     lo[1] + (iy as f64 + 0.5) * c,
                                     lo[2] + (iz as f64 + 0.5) * c,
                                 );
-                                if levelset_point_triangle(&p, a, b2, c2) <= reach {
+                                if levelset::mesh::point_triangle_distance(&p, &a, &b2, &c2)
+                                    <= reach
+                                {
                                     let pl = tri_plane[t];
                                     if !per_cell[idx].contains(&pl) {
                                         per_cell[idx].push(pl);
@@ -270,49 +272,6 @@ impl Walls {
             }
         }
     }
-}
-
-/// Distance from `p` to triangle `abc` (Ericson 2005, §5.1.5).
-fn levelset_point_triangle(p: &Point3<f64>, a: Point3<f64>, b: Point3<f64>, c: Point3<f64>) -> f64 {
-    let ab = b - a;
-    let ac = c - a;
-    let ap = p - a;
-    let d1 = ab.dot(&ap);
-    let d2 = ac.dot(&ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return ap.norm();
-    }
-    let bp = p - b;
-    let d3 = ab.dot(&bp);
-    let d4 = ac.dot(&bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return bp.norm();
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (p - (a + v * ab)).norm();
-    }
-    let cp = p - c;
-    let d5 = ab.dot(&cp);
-    let d6 = ac.dot(&cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return cp.norm();
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (p - (a + w * ac)).norm();
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (p - (b + w * (c - b))).norm();
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let v = vb * denom;
-    let w = vc * denom;
-    (p - (a + ab * v + ac * w)).norm()
 }
 
 #[inline]
@@ -437,13 +396,11 @@ fn spin_receive<T>(rx: &mpsc::Receiver<T>) -> Option<T> {
 }
 
 /// The open sites with the lag-one rule's pending sphere.
-struct Lag<'p> {
+struct Lag {
     sites: Sites,
     /// The last placed sphere, whose sites are not merged yet.
     pending: Option<(u32, f64)>,
     pipe: Option<Pipe>,
-    #[allow(dead_code)]
-    marker: std::marker::PhantomData<&'p ()>,
 }
 
 /// Number of capacity levels of the waiting sites.
@@ -679,11 +636,6 @@ impl Sites {
             }
         }
         best
-    }
-    /// Puts a popped site back unchanged (its capacity is already a level
-    /// capacity).
-    fn push_back(&mut self, s: Site) {
-        self.push(s);
     }
     /// Whether any site waits.
     fn is_empty(&self) -> bool {
@@ -1306,7 +1258,7 @@ impl<'a> Front3<'a> {
                 slot: 0,
             });
         }
-        let mut main = |this: &mut Self, lag: &mut Lag<'_>| {
+        let mut main = |this: &mut Self, lag: &mut Lag| {
             // The window of upcoming radii, oldest first.
             let w = lookahead.max(1);
             let mut window: Vec<f64> = Vec::with_capacity(w);
@@ -1360,10 +1312,10 @@ impl<'a> Front3<'a> {
                         if lag.sites.peek_for(r_small).is_some_and(|t| t > &site) {
                             // A new site is lower: the sequential loop would
                             // have taken it first.
-                            lag.sites.push_back(site);
+                            lag.sites.push(site);
                             cache.push((site.slot, o));
                             for (rest, ro) in iter.by_ref() {
-                                lag.sites.push_back(rest);
+                                lag.sites.push(rest);
                                 cache.push((rest.slot, ro));
                             }
                             break;
@@ -1441,7 +1393,6 @@ impl<'a> Front3<'a> {
                         jobs: job_tx,
                         results: res_rx,
                     }),
-                    marker: std::marker::PhantomData,
                 };
                 main(self, &mut lag);
                 // Closing the job channel stops the worker.
@@ -1457,7 +1408,6 @@ impl<'a> Front3<'a> {
                 sites,
                 pending: None,
                 pipe: None,
-                marker: std::marker::PhantomData,
             };
             main(self, &mut lag);
         }
@@ -1521,7 +1471,7 @@ impl<'a> Front3<'a> {
         &mut self,
         site: Site,
         o: Outcome,
-        lag: &mut Lag<'_>,
+        lag: &mut Lag,
         window: &mut Vec<f64>,
         g_of: &dyn Fn(&Self, u32) -> f64,
     ) -> bool {
@@ -1569,7 +1519,7 @@ impl<'a> Front3<'a> {
     }
 
     /// Adds the pending sphere's sites (from the worker) to the open sites.
-    fn merge_pending(&mut self, lag: &mut Lag<'_>, ready: Option<Vec<Site>>) {
+    fn merge_pending(&mut self, lag: &mut Lag, ready: Option<Vec<Site>>) {
         if lag.pending.take().is_none() {
             return;
         }

@@ -10,8 +10,6 @@ const NIL: u32 = u32::MAX;
 #[derive(Debug, Clone)]
 pub(crate) struct Grid3 {
     lo: [f64; 3],
-    /// Cell size per axis (periodic axes: the period divided evenly).
-    cell: [f64; 3],
     inv: [f64; 3],
     n: [usize; 3],
     /// Period per axis (0 when not periodic).
@@ -54,7 +52,6 @@ impl Grid3 {
         }
         Self {
             lo: [lo.x, lo.y, lo.z],
-            cell: csz,
             inv: [1.0 / csz[0], 1.0 / csz[1], 1.0 / csz[2]],
             n,
             period,
@@ -184,11 +181,5 @@ impl Grid3 {
     /// Heap bytes held.
     pub(crate) fn heap_bytes(&self) -> usize {
         4 * (self.head.capacity() + self.next.capacity())
-    }
-
-    /// The cell size actually used per axis.
-    #[allow(dead_code)]
-    pub(crate) fn cell(&self) -> [f64; 3] {
-        self.cell
     }
 }

@@ -596,35 +596,7 @@ pub fn write_vtu3(spheres: &[Sphere], mut w: impl Write) -> Result<()> {
     for s in spheres {
         writeln!(w, "{:e} {:e} {:e}", s.center.x, s.center.y, s.center.z)?;
     }
-    writeln!(w, "</DataArray>")?;
-    writeln!(w, "</Points>")?;
-    writeln!(w, "<Cells>")?;
-    writeln!(
-        w,
-        r#"<DataArray type="Int64" Name="connectivity" format="ascii">"#
-    )?;
-    for i in 0..n {
-        writeln!(w, "{i}")?;
-    }
-    writeln!(w, "</DataArray>")?;
-    writeln!(
-        w,
-        r#"<DataArray type="Int64" Name="offsets" format="ascii">"#
-    )?;
-    for i in 1..=n {
-        writeln!(w, "{i}")?;
-    }
-    writeln!(w, "</DataArray>")?;
-    writeln!(w, r#"<DataArray type="UInt8" Name="types" format="ascii">"#)?;
-    for _ in 0..n {
-        writeln!(w, "1")?;
-    }
-    writeln!(w, "</DataArray>")?;
-    writeln!(w, "</Cells>")?;
-    writeln!(w, "</Piece>")?;
-    writeln!(w, "</UnstructuredGrid>")?;
-    writeln!(w, "</VTKFile>")?;
-    Ok(())
+    crate::io::write_vtu_vertex_cells(n, &mut w)
 }
 
 /// Reads back points and the `radius` point array of an ASCII VTK XML
