@@ -120,6 +120,7 @@ impl Run3<'_> {
             Preset::Dense => Pack3Params::dense(),
             Preset::Seed => Pack3Params {
                 lookahead: 1,
+                slab_width: 0.0,
                 ..Pack3Params::default()
             },
         };
@@ -185,9 +186,10 @@ impl Run3<'_> {
         );
         let _ = writeln!(
             text,
-            "packer: front order {:?}, {} site generations, {} site tests, {} sites dropped, {} \
-             sizes drawn, {} skipped, packer structures {:.1} MB",
+            "packer: front order {:?}, {} slab(s), {} site generations, {} site tests, {} sites \
+             dropped, {} sizes drawn, {} skipped, packer structures {:.1} MB",
             p.front_order,
+            p.stats.slabs.max(1),
             p.stats.evaluations,
             p.stats.site_tests,
             p.stats.fronts_removed,

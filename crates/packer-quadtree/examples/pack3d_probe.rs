@@ -27,11 +27,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .and_then(|s| s.parse().ok())
             .unwrap_or(8),
         front_order: order,
+        slab_width: std::env::var("SLAB")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(Pack3Params::default().slab_width),
         ..Pack3Params::default()
     };
     let t = std::time::Instant::now();
     let p = pack3d_seeded(&c, &grading, &params, 1)?;
     let el = t.elapsed().as_secs_f64();
+    if std::env::var("CHECK").is_ok() {
+        let rep = packer_quadtree::check_spheres(&c, &p.spheres, 1e-9)?;
+        println!(
+            "check: worst gap {:.3e} wall {:.3e}",
+            rep.worst_normalised_gap, rep.worst_normalised_wall_gap
+        );
+    }
     let m = 2.0 * dmax;
     let lo = Point3::new(m, m, m);
     let hi = Point3::new(side - m, side - m, side - m);
@@ -45,6 +56,35 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let core = (side - 2.0 * m).powi(3);
+    if let Ok(w) = std::env::var("XPROF") {
+        // Solid fraction in x-bins of width w over the core in y and z
+        // (centre-in-core spheres only, exact slab volumes in x).
+        let w: f64 = w.parse()?;
+        let nb = (side / w).ceil() as usize;
+        let mut bins = vec![0.0; nb];
+        for s in &p.spheres {
+            if !(1..3).all(|k| s.center[k] >= lo[k] && s.center[k] <= hi[k]) {
+                continue;
+            }
+            let r = s.radius;
+            let cum = |x: f64| {
+                let t = x.clamp(-r, r);
+                std::f64::consts::PI * (r * r * t - t * t * t / 3.0)
+            };
+            let b0 = ((s.center.x - r) / w).floor().max(0.0) as usize;
+            let b1 = (((s.center.x + r) / w).floor() as usize).min(nb - 1);
+            for b in b0..=b1 {
+                let (a, c) = (b as f64 * w - s.center.x, (b + 1) as f64 * w - s.center.x);
+                bins[b] += cum(c) - cum(a);
+            }
+        }
+        let area = (side - 2.0 * m) * (side - 2.0 * m);
+        let line: Vec<String> = bins
+            .iter()
+            .map(|v| format!("{:.3}", v / (area * w)))
+            .collect();
+        println!("xprof {}", line.join(" "));
+    }
     println!(
         "n {} time {:.3}s  overall {:.4} core(centre) {:.4} order {:?} stats {:?}",
         p.spheres.len(),

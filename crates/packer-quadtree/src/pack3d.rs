@@ -65,14 +65,29 @@
 //! would only add depth: the 2D comparison found the grid faster at every
 //! size, and 3D sphere sizes of a grading are as uniform.
 //!
-//! Determinism: sizes come from the caller's RNG; the packer is sequential
-//! and deterministic; the portfolio runs in parallel and keeps the densest
-//! (ties: the earlier order), so the result is identical for any thread
-//! count.
+//! **Slabs** ([`Pack3Params::slab_width`], on in `default`, off in
+//! `dense`): a box at least two slabs wide is cut along `x` into slabs of
+//! about 8 `d_max` or more (a multiple of 4 of them); the even slabs are
+//! packed in parallel, each by its own front whose sites stop at the slab's
+//! faces, then the odd slabs in parallel against their packed neighbours.
+//! The sequential front fills the whole cross-section layer by layer, so
+//! its working set grows with the box and falls out of the caches at 10⁶
+//! spheres (18 µs per sphere against 11 µs at 10⁵); a slab's is a fraction
+//! of it, and two slabs pack at once. The price is a thin layering at each
+//! face (an even slab's face acts on centres as a wall): about 0.003 of
+//! solid fraction at 4 slabs across 40 `d_max`. Details in `slabs.rs`.
+//!
+//! Determinism: sizes come from the caller's RNG (for slabs: one seed from
+//! it, then the ChaCha8 stream of the slab's index); the front is
+//! sequential and deterministic, slabs of one phase do not interact and are
+//! assembled in slab order; the portfolio runs in parallel and keeps the
+//! densest (ties: the earlier order), so the result is identical for any
+//! thread count.
 
 mod container;
 mod io;
 mod metrics;
+mod slabs;
 
 pub use container::{Container, MeshContainer};
 pub use io::{
@@ -133,6 +148,14 @@ pub struct Pack3Params {
     /// Upper bound on the number of spheres (guards against a unit mistake
     /// exhausting memory; checked against the estimate before any work).
     pub max_particles: usize,
+    /// Slab width in units of `d_max` for the slab-parallel packing of a
+    /// box by [`pack3d`] (`0`: off; widths below 6 are raised to 6): the
+    /// box is cut along `x` into `⌊L_x / (width · d_max)⌋` slabs, packed
+    /// even ones first and odd ones against them, each phase in parallel
+    /// (see the module docs). Boxes narrower than two slabs, cylinders,
+    /// meshes and [`pack3d_sizes`] (whose size order is the caller's) pack
+    /// sequentially.
+    pub slab_width: f64,
 }
 
 impl Default for Pack3Params {
@@ -143,19 +166,22 @@ impl Default for Pack3Params {
             max_skips: 0,
             pipeline: true,
             max_particles: 50_000_000,
+            slab_width: 8.0,
         }
     }
 }
 
 impl Pack3Params {
     /// The densest configuration: the portfolio of front orders (run in
-    /// parallel, densest kept), a look-ahead of 32 sizes and up to 256
-    /// skipped sizes to fill the last pockets.
+    /// parallel, densest kept), a look-ahead of 32 sizes, up to 256
+    /// skipped sizes to fill the last pockets, and no slabs (a slab face
+    /// costs about 0.003 of solid fraction at 4 slabs per 40 `d_max`).
     pub fn dense() -> Self {
         Self {
             front_order: FrontOrder::Best,
             lookahead: 32,
             max_skips: 256,
+            slab_width: 0.0,
             ..Self::default()
         }
     }
@@ -170,6 +196,13 @@ impl Pack3Params {
                 what: "lookahead",
                 value: 0.0,
                 range: "[1, inf)",
+            });
+        }
+        if !(self.slab_width.is_finite() && self.slab_width >= 0.0) {
+            return Err(Error::Parameter {
+                what: "slab_width",
+                value: self.slab_width,
+                range: "[0, inf)",
             });
         }
         if self.max_particles == 0 {
@@ -206,7 +239,8 @@ fn mean_volume(grading: &Grading) -> f64 {
 
 /// Packs `container` with spheres whose diameters follow `grading` (by
 /// number), drawn by inverse-transform sampling from `rng` and used in
-/// draw order.
+/// draw order (per slab from streams of one seed drawn from `rng` when
+/// the box is slabbed, see [`Pack3Params::slab_width`]).
 ///
 /// # Errors
 /// Validation errors of the container, grading and parameters;
@@ -231,6 +265,33 @@ pub fn pack3d(
             estimate: est,
             limit: params.max_particles,
         });
+    }
+    let n_slabs = slabs::slab_count(container, d_max, params.slab_width);
+    if n_slabs > 1
+        && let Container::Box { min, max, periodic } = container
+    {
+        let seed = rng.next_u64();
+        return pack_slabbed(
+            |order| slabs::SlabJob {
+                min: *min,
+                max: *max,
+                periodic: *periodic,
+                n: n_slabs,
+                d_lo: d_min,
+                d_hi: d_max,
+                grading,
+                seed,
+                order,
+                lookahead: params.lookahead,
+                max_skips: params.max_skips,
+                max_particles: params.max_particles,
+                pipeline: params.pipeline && params.front_order != FrontOrder::Best,
+                estimate: est as usize,
+            },
+            params,
+            inscribed,
+            d_max,
+        );
     }
     let sizes: Vec<f64> = (0..est as usize).map(|_| grading.sample(rng)).collect();
     // Validated above: every drawn size lies in [d_min, d_max].
@@ -310,6 +371,65 @@ pub fn pack3d_sizes(
     pack_checked(container, sizes, lo, hi, inscribed, params)
 }
 
+/// The slab-parallel packing ([`slabs`]) for each front order of
+/// `params`, densest kept.
+fn pack_slabbed<'a>(
+    job: impl Fn(FrontOrder) -> slabs::SlabJob<'a> + Sync,
+    params: &Pack3Params,
+    inscribed: f64,
+    d_max: f64,
+) -> Result<Packing3> {
+    let runs: Vec<Packing3> = orders_of(params)
+        .par_iter()
+        .map(|&order| {
+            let (xs, stats) = job(order).pack();
+            Packing3 {
+                spheres: xs
+                    .iter()
+                    .map(|q| Sphere {
+                        center: Point3::new(q[0], q[1], q[2]),
+                        radius: q[3],
+                    })
+                    .collect(),
+                front_order: order,
+                stats,
+            }
+        })
+        .collect();
+    densest(runs, inscribed, d_max)
+}
+
+/// The front orders a parameter set runs.
+fn orders_of(params: &Pack3Params) -> Vec<FrontOrder> {
+    if params.front_order == FrontOrder::Best {
+        vec![
+            FrontOrder::LowestCandidate,
+            FrontOrder::Stack,
+            FrontOrder::LowestFirst,
+        ]
+    } else {
+        vec![params.front_order]
+    }
+}
+
+/// The densest run; ties keep the earlier order.
+fn densest(runs: Vec<Packing3>, inscribed: f64, d: f64) -> Result<Packing3> {
+    let mut best: Option<(f64, Packing3)> = None;
+    for p in runs {
+        let v: f64 = p.spheres.iter().map(|s| s.radius.powi(3)).sum();
+        if best.as_ref().is_none_or(|(b, _)| v > *b) {
+            best = Some((v, p));
+        }
+    }
+    match best {
+        Some((_, p)) if !p.spheres.is_empty() => Ok(p),
+        _ => Err(Error::DomainTooSmall {
+            domain: inscribed,
+            particle: d,
+        }),
+    }
+}
+
 /// The packing proper, on validated input.
 fn pack_checked(
     container: &Container,
@@ -319,15 +439,7 @@ fn pack_checked(
     inscribed: f64,
     params: &Pack3Params,
 ) -> Result<Packing3> {
-    let orders: Vec<FrontOrder> = if params.front_order == FrontOrder::Best {
-        vec![
-            FrontOrder::LowestCandidate,
-            FrontOrder::Stack,
-            FrontOrder::LowestFirst,
-        ]
-    } else {
-        vec![params.front_order]
-    };
+    let orders = orders_of(params);
     let runs: Vec<Packing3> = orders
         .par_iter()
         .map(|&order| {
@@ -340,6 +452,7 @@ fn pack_checked(
                 params.lookahead,
                 params.max_skips,
                 params.pipeline && orders.len() == 1,
+                front::Start::default(),
             );
             let stats = f.stats;
             Packing3 {
@@ -356,21 +469,7 @@ fn pack_checked(
             }
         })
         .collect();
-    // Densest run; ties keep the earlier order.
-    let mut best: Option<(f64, Packing3)> = None;
-    for p in runs {
-        let v: f64 = p.spheres.iter().map(|s| s.radius.powi(3)).sum();
-        if best.as_ref().is_none_or(|(b, _)| v > *b) {
-            best = Some((v, p));
-        }
-    }
-    match best {
-        Some((_, p)) if !p.spheres.is_empty() => Ok(p),
-        _ => Err(Error::DomainTooSmall {
-            domain: inscribed,
-            particle: sizes[0],
-        }),
-    }
+    densest(runs, inscribed, sizes[0])
 }
 
 #[cfg(test)]

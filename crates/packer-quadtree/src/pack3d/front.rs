@@ -59,6 +59,8 @@ pub struct Pack3Stats {
     pub pops: u64,
     /// Sites generated.
     pub sites: u64,
+    /// Slabs of a slab-parallel packing (0 or 1: one front).
+    pub slabs: u64,
 }
 
 /// A wall plane `n · x = o` (unit `n` pointing into the container).
@@ -423,6 +425,10 @@ struct Sites {
     cell_of: Vec<u32>,
     free: Vec<u32>,
     grid: SiteGrid,
+    /// Sites are kept only if their key's `x` lies in `[region[0],
+    /// region[1])` (the slab of a slab-parallel packing; unbounded
+    /// otherwise).
+    region: [f64; 2],
 }
 
 /// Open sites by their smallest-size centre, so that a new sphere kills
@@ -481,6 +487,9 @@ impl SiteGrid {
 impl Sites {
     /// Registers a new site and queues it.
     fn add(&mut self, mut s: Site) {
+        if !(s.k[0] >= self.region[0] && s.k[0] < self.region[1]) {
+            return;
+        }
         let slot = match self.free.pop() {
             Some(x) => x,
             None => {
@@ -575,6 +584,7 @@ impl Sites {
             cell_of: Vec::new(),
             free: Vec::new(),
             grid: SiteGrid::new(lo, hi, 2.0 * r_max, periodic),
+            region: [f64::NEG_INFINITY, f64::INFINITY],
         }
     }
     /// Capacity of level `j`.
@@ -685,7 +695,21 @@ pub(crate) struct Front3<'a> {
     /// Sites of one placement (sequential mode).
     batch: Vec<Site>,
     last_block: usize,
+    /// `x` of the first sphere's wall side in a box (default: the box's
+    /// `min.x`; a slab's left end).
+    seed_x: Option<f64>,
     pub(crate) stats: Pack3Stats,
+}
+
+/// How a run starts: the whole container from a seed sphere (default), or
+/// one slab of a slab-parallel packing (sites restricted to `region`;
+/// `imported`: spheres of the neighbouring slabs, placed first as
+/// obstacles, whose sites near the slab start the front).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Start {
+    pub(crate) region: Option<[f64; 2]>,
+    pub(crate) seed_x: Option<f64>,
+    pub(crate) imported: Vec<[f64; 4]>,
 }
 
 impl<'a> Front3<'a> {
@@ -718,6 +742,7 @@ impl<'a> Front3<'a> {
             kept: Vec::with_capacity(64),
             batch: Vec::with_capacity(64),
             last_block: 0,
+            seed_x: None,
             stats: Pack3Stats::default(),
         }
     }
@@ -796,7 +821,7 @@ impl<'a> Front3<'a> {
     fn seed(&mut self, r: f64) -> Option<u32> {
         let p = match (&self.walls, self.container) {
             (Walls::Planes(_), Container::Box { min, .. }) => {
-                Some([min.x + r, min.y + r, min.z + r])
+                Some([self.seed_x.unwrap_or(min.x) + r, min.y + r, min.z + r])
             }
             (
                 Walls::Cylinder {
@@ -1209,20 +1234,9 @@ impl<'a> Front3<'a> {
         lookahead: usize,
         max_skips: usize,
         pipeline: bool,
+        start: Start,
     ) {
-        let mut k = 0usize;
-        let first = loop {
-            let Some(d) = sizes(k) else { return };
-            k += 1;
-            self.stats.sizes_drawn += 1;
-            if let Some(id) = self.seed(0.5 * d) {
-                break id;
-            }
-            self.stats.sizes_skipped += 1;
-            if k > MAX_SKIPS {
-                return;
-            }
-        };
+        self.seed_x = start.seed_x;
         // Secondary key per order: lowest candidate (none), lowest
         // generating sphere, newest generating sphere (stack).
         let gkey = |s: &Self, id: u32| match order {
@@ -1238,25 +1252,66 @@ impl<'a> Front3<'a> {
             [bhi.x, bhi.y, bhi.z],
             self.periodic,
         );
-        let g = gkey(self, first);
+        let mut k = 0usize;
         let mut batch = Vec::new();
-        self.generate(first, g, &mut batch);
-        for st in batch.drain(..) {
-            sites.add(st);
+        if let Some(region) = start.region {
+            sites.region = region;
         }
-        if sites.is_empty()
-            && let Some(floor) = self.all_planes.iter().position(|w| w.n[2] > 0.999_999)
-        {
-            // Periodic in x and y: nothing but the floor around the first
-            // sphere; the second one sits beside it.
-            let q = self.xs[first as usize];
-            sites.add(Site {
-                k: [q[0] + q[3] + self.r_min, q[1], q[2]],
-                ids: [first, WALL + floor as u32, FREE],
-                g,
-                cap: f64::INFINITY,
-                slot: 0,
-            });
+        if !start.imported.is_empty() {
+            // A slab between packed neighbours: their spheres are obstacles,
+            // and those within reach of the slab start the front.
+            let reach = 2.0 * self.r_max;
+            let (x0, x1) = (sites.region[0] - reach, sites.region[1] + reach);
+            let first = self.xs.len() as u32;
+            for q in &start.imported {
+                self.place([q[0], q[1], q[2]], q[3]);
+            }
+            for id in first..self.xs.len() as u32 {
+                let x = self.xs[id as usize][0];
+                if x >= x0 && x < x1 {
+                    let g = gkey(self, id);
+                    self.generate(id, g, &mut batch);
+                    for st in batch.drain(..) {
+                        sites.add(st);
+                    }
+                }
+            }
+            if sites.is_empty() {
+                return;
+            }
+        } else {
+            let first = loop {
+                let Some(d) = sizes(k) else { return };
+                k += 1;
+                self.stats.sizes_drawn += 1;
+                if let Some(id) = self.seed(0.5 * d) {
+                    break id;
+                }
+                self.stats.sizes_skipped += 1;
+                if k > MAX_SKIPS {
+                    return;
+                }
+            };
+            let g = gkey(self, first);
+            self.generate(first, g, &mut batch);
+            for st in batch.drain(..) {
+                sites.add(st);
+            }
+            if sites.is_empty()
+                && let Some(floor) = self.all_planes.iter().position(|w| w.n[2] > 0.999_999)
+            {
+                // Periodic in x and y (or a slab periodic in y): nothing
+                // but the floor around the first sphere; the second one
+                // sits beside it.
+                let q = self.xs[first as usize];
+                sites.add(Site {
+                    k: [q[0] + q[3] + self.r_min, q[1], q[2]],
+                    ids: [first, WALL + floor as u32, FREE],
+                    g,
+                    cap: f64::INFINITY,
+                    slot: 0,
+                });
+            }
         }
         let mut main = |this: &mut Self, lag: &mut Lag| {
             // The window of upcoming radii, oldest first.
