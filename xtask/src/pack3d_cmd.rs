@@ -120,7 +120,7 @@ impl Run3<'_> {
             Preset::Dense => Pack3Params::dense(),
             Preset::Seed => Pack3Params {
                 lookahead: 1,
-                slab_width: 0.0,
+                slabs: 0,
                 ..Pack3Params::default()
             },
         };

@@ -27,10 +27,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .and_then(|s| s.parse().ok())
             .unwrap_or(8),
         front_order: order,
-        slab_width: std::env::var("SLAB")
+        slabs: std::env::var("SLABS")
             .ok()
             .and_then(|s| s.parse().ok())
-            .unwrap_or(Pack3Params::default().slab_width),
+            .unwrap_or(Pack3Params::default().slabs),
         ..Pack3Params::default()
     };
     let t = std::time::Instant::now();

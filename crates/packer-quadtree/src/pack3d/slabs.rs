@@ -41,26 +41,24 @@ use crate::packer::FrontOrder;
 /// own periodic images).
 pub(super) const MIN_SLAB: f64 = 6.0;
 
-/// Number of slabs for a container: `m = ⌊L_x / (width · d_max)⌋` for a
-/// box, rounded down to a multiple of 4 when `m ≥ 4` (each phase then has
-/// an even number of slabs, which balances two cores; the count must not
-/// depend on the thread count, or the packing would), to 2 when `m` is 2
-/// or 3; otherwise 1 (no slabs). Always even, as a box periodic in `x`
-/// needs.
-pub(super) fn slab_count(container: &Container, d_max: f64, width: f64) -> usize {
-    if !(width.is_finite() && width > 0.0) {
-        return 1;
-    }
-    let Container::Box { min, max, .. } = container else {
+/// Number of slabs for a container: `requested`, lowered until every slab
+/// is at least `MIN_SLAB · d_max` wide and made even when the box is
+/// periodic in `x` (the last slab's neighbour is then the first); 1 (no
+/// slabs) for anything but a box, or when fewer than 2 remain.
+pub(super) fn slab_count(container: &Container, d_max: f64, requested: usize) -> usize {
+    let Container::Box { min, max, periodic } = container else {
         return 1;
     };
-    let w = width.max(MIN_SLAB) * d_max;
-    let m = ((max.x - min.x) / w).floor() as usize;
-    match m {
-        0 | 1 => 1,
-        2 | 3 => 2,
-        _ => m - m % 4,
+    let fit = ((max.x - min.x) / (MIN_SLAB * d_max)).floor();
+    let mut n = if fit.is_finite() && fit >= 0.0 {
+        requested.min(fit as usize)
+    } else {
+        0
+    };
+    if periodic[0] {
+        n -= n % 2;
     }
+    if n < 2 { 1 } else { n }
 }
 
 /// What one slab run needs.

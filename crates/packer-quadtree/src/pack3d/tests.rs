@@ -389,7 +389,7 @@ proptest! {
 #[test]
 fn slab_packing_is_overlap_free_deterministic_and_dense() {
     let params = Pack3Params {
-        slab_width: 6.0,
+        slabs: 4,
         ..Pack3Params::default()
     };
     let boxes = [
@@ -411,7 +411,7 @@ fn slab_packing_is_overlap_free_deterministic_and_dense() {
         },
     ];
     for c in &boxes {
-        assert!(slabs::slab_count(c, 2.0, 6.0) >= 2, "{c:?} is not slabbed");
+        assert!(slabs::slab_count(c, 2.0, 4) >= 2, "{c:?} is not slabbed");
         let run = |threads: usize, params: Pack3Params| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -428,13 +428,7 @@ fn slab_packing_is_overlap_free_deterministic_and_dense() {
         );
         let worst = brute_worst(c, &p1.spheres);
         assert!(worst >= -1e-9, "{c:?}: worst gap {worst}");
-        let seq = run(
-            2,
-            Pack3Params {
-                slab_width: 0.0,
-                ..params
-            },
-        );
+        let seq = run(2, Pack3Params { slabs: 0, ..params });
         let (f_slab, f_seq) = (
             solid_fraction(c, &p1.spheres).expect("fraction"),
             solid_fraction(c, &seq.spheres).expect("fraction"),
@@ -445,19 +439,8 @@ fn slab_packing_is_overlap_free_deterministic_and_dense() {
         );
     }
     assert_eq!(
-        slabs::slab_count(&Container::triaxial(100.0), 2.0, 6.0),
+        slabs::slab_count(&Container::triaxial(100.0), 2.0, 4),
         1,
         "cylinders pack sequentially"
     );
-    assert!(matches!(
-        Pack3Params {
-            slab_width: f64::NAN,
-            ..Pack3Params::default()
-        }
-        .validate(),
-        Err(Error::Parameter {
-            what: "slab_width",
-            ..
-        })
-    ));
 }
