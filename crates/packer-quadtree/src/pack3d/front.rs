@@ -1177,15 +1177,13 @@ impl<'a> Front3<'a> {
     }
 
     /// Gathers the spheres near `site` for the capacity bisection on
-    /// `[r_min, r]`: those within `r + r_max + δ` of the site's centre for
-    /// `r_min`, with `δ` the distance between its centres for `r_min` and
+    /// `[r_min, r]`: those within `r + r_max + δ` of the site's centre `c`
+    /// for `r_min`, with `δ` the distance between its centres for `r_min` and
     /// `r` (the site moves little between the two). The capacity is only an
     /// estimate (a placement is always checked against the full index), so
     /// a sphere missed by a curving path costs at most a retry.
-    fn gather_local(&mut self, site: &Site, r: f64) -> bool {
-        let Some(c) = self.site_position(site, self.r_min) else {
-            return false;
-        };
+    fn gather_local(&mut self, site: &Site, c: &[f64; 3], r: f64) {
+        let c = *c;
         let delta = self.site_position(site, r).map_or(r - self.r_min, |q| {
             ((q[0] - c[0]).powi(2) + (q[1] - c[1]).powi(2) + (q[2] - c[2]).powi(2)).sqrt()
         });
@@ -1202,7 +1200,6 @@ impl<'a> Front3<'a> {
                 local.push(p);
             }
         });
-        true
     }
 
     /// [`Front3::try_site`] against the gathered spheres (radius at most
@@ -1473,22 +1470,27 @@ impl<'a> Front3<'a> {
     fn decide(&mut self, site: &Site, window: &[f64]) -> Outcome {
         self.stats.pops += 1;
         let r0 = window[0];
-        if site.cap >= r0
-            && let Some(p) = self.try_site(site, r0)
-        {
-            return Outcome::Place { p, r: r0, i: 0 };
+        let mut r0_failed = false;
+        if site.cap >= r0 {
+            if let Some(p) = self.try_site(site, r0) {
+                return Outcome::Place { p, r: r0, i: 0 };
+            }
+            r0_failed = true;
         }
-        if self.try_site(site, self.r_min).is_none() {
+        self.stats.site_tests += 1;
+        let Some(c) = self.site_position(site, self.r_min) else {
+            return Outcome::Drop;
+        };
+        if !self.feasible(&c, self.r_min) {
             return Outcome::Drop;
         }
         // Capacity by bisection on [r_min, min(r0, cap)] to 1/16, against
-        // the spheres gathered once.
+        // the spheres gathered once (the top is known to fail when it is
+        // r0 and r0 failed against the full index).
         let top = r0.min(site.cap);
-        if !self.gather_local(site, top) {
-            return Outcome::Drop;
-        }
+        self.gather_local(site, &c, top);
         let (mut lo, mut hi) = (self.r_min, top);
-        if self.try_local(site, hi) {
+        if !(r0_failed && top == r0) && self.try_local(site, hi) {
             lo = hi;
         } else {
             for _ in 0..BISECTIONS {
