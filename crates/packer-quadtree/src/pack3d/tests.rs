@@ -410,6 +410,7 @@ fn slab_packing_is_overlap_free_deterministic_and_dense() {
             periodic: [false, true],
         },
     ];
+    let mut digests = Vec::new();
     for c in &boxes {
         assert!(slabs::slab_count(c, 2.0, 4) >= 2, "{c:?} is not slabbed");
         let run = |threads: usize, params: Pack3Params| {
@@ -426,6 +427,7 @@ fn slab_packing_is_overlap_free_deterministic_and_dense() {
             (p2.spheres.len(), digest(&p2)),
             "{c:?}: thread count changed the packing"
         );
+        digests.push((p1.spheres.len(), digest(&p1)));
         let worst = brute_worst(c, &p1.spheres);
         assert!(worst >= -1e-9, "{c:?}: worst gap {worst}");
         let seq = run(2, Pack3Params { slabs: 0, ..params });
@@ -438,9 +440,13 @@ fn slab_packing_is_overlap_free_deterministic_and_dense() {
             "{c:?}: slabs {f_slab:.4} against sequential {f_seq:.4}"
         );
     }
+    println!("slab golden {digests:x?}");
+    assert_eq!(digests[0], SLAB_GOLDEN);
     assert_eq!(
         slabs::slab_count(&Container::triaxial(100.0), 2.0, 4),
         1,
         "cylinders pack sequentially"
     );
 }
+
+const SLAB_GOLDEN: (usize, u64) = (0x566, 0x8820_1247_1b67_32fd);
