@@ -320,13 +320,41 @@ impl PartialOrd for Site {
     }
 }
 impl Ord for Site {
-    // Reversed: the max-heap pops the lowest key.
+    // Reversed: the max-heap pops the lowest key; the same order as
+    // [`Key`].
     fn cmp(&self, o: &Self) -> Ordering {
         o.g.total_cmp(&self.g)
             .then(o.k[2].total_cmp(&self.k[2]))
-            .then(o.k[0].total_cmp(&self.k[0]))
-            .then(o.k[1].total_cmp(&self.k[1]))
-            .then(o.ids.cmp(&self.ids))
+            .then(o.slot.cmp(&self.slot))
+    }
+}
+
+/// A waiting site in a heap: its order keys and registry slot (24 bytes;
+/// the site itself stays in the registry). Ties in `z` (a floor layer of
+/// equal spheres) go to the lower slot: slots are handed out in a
+/// deterministic order, so the packing is.
+#[derive(Clone, Copy, Debug)]
+struct Key {
+    g: f64,
+    z: f64,
+    slot: u32,
+}
+impl PartialEq for Key {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Key {}
+impl PartialOrd for Key {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Key {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.g.total_cmp(&self.g)
+            .then(o.z.total_cmp(&self.z))
+            .then(o.slot.cmp(&self.slot))
     }
 }
 
@@ -415,7 +443,9 @@ const LEVELS: usize = 16;
 /// whose capacity is at least `r`; the next site is the lowest key among
 /// their tops (at most 17 comparisons, no re-queuing when sizes change).
 struct Sites {
-    heaps: Vec<BinaryHeap<Site>>,
+    heaps: Vec<BinaryHeap<Key>>,
+    /// The sites by slot.
+    data: Vec<Site>,
     r_min: f64,
     step: f64,
     len: usize,
@@ -495,6 +525,7 @@ impl Sites {
             None => {
                 self.alive.push(false);
                 self.cell_of.push(0);
+                self.data.push(s);
                 (self.alive.len() - 1) as u32
             }
         };
@@ -577,6 +608,7 @@ impl Sites {
     fn new(r_min: f64, r_max: f64, lo: [f64; 3], hi: [f64; 3], periodic: [bool; 2]) -> Self {
         Self {
             heaps: (0..=LEVELS).map(|_| BinaryHeap::new()).collect(),
+            data: Vec::new(),
             r_min,
             step: (r_max - r_min) / LEVELS as f64,
             len: 0,
@@ -612,40 +644,41 @@ impl Sites {
             j += 1;
         }
         let cap = self.cap(j);
-        self.heaps[j].push(Site { cap, ..s });
+        self.data[s.slot as usize] = Site { cap, ..s };
+        self.heaps[j].push(Key {
+            g: s.g,
+            z: s.k[2],
+            slot: s.slot,
+        });
         self.len += 1;
     }
     /// The lowest site among the levels that can take radius `r`.
     fn pop_for(&mut self, r: f64) -> Option<Site> {
-        let mut best: Option<(usize, Site)> = None;
-        for j in (0..=LEVELS).rev() {
-            if self.cap(j) < r * (1.0 - 1e-12) {
-                break;
-            }
-            if let Some(t) = self.heaps[j].peek()
-                && best.as_ref().is_none_or(|(_, b)| t > b)
-            {
-                best = Some((j, *t));
-            }
-        }
-        let (j, _) = best?;
+        let j = self.best_level(r)?;
         self.len -= 1;
-        self.heaps[j].pop()
+        let key = self.heaps[j].pop()?;
+        Some(self.data[key.slot as usize])
     }
     /// The site [`Sites::pop_for`] would return, without removing it.
-    fn peek_for(&self, r: f64) -> Option<&Site> {
-        let mut best: Option<&Site> = None;
+    fn peek_for(&self, r: f64) -> Option<Site> {
+        let j = self.best_level(r)?;
+        let key = self.heaps[j].peek()?;
+        Some(self.data[key.slot as usize])
+    }
+    /// The level whose top is the lowest among those that take radius `r`.
+    fn best_level(&self, r: f64) -> Option<usize> {
+        let mut best: Option<(usize, &Key)> = None;
         for j in (0..=LEVELS).rev() {
             if self.cap(j) < r * (1.0 - 1e-12) {
                 break;
             }
             if let Some(t) = self.heaps[j].peek()
-                && best.is_none_or(|b| t > b)
+                && best.is_none_or(|(_, b)| t > b)
             {
-                best = Some(t);
+                best = Some((j, t));
             }
         }
-        best
+        best.map(|(j, _)| j)
     }
     /// Whether any site waits.
     fn is_empty(&self) -> bool {
@@ -1361,7 +1394,7 @@ impl<'a> Front3<'a> {
                     this.merge_pending(lag, ready);
                     let mut iter = std::mem::take(&mut spec).into_iter();
                     while let Some((site, o)) = iter.next() {
-                        if lag.sites.peek_for(r_small).is_some_and(|t| t > &site) {
+                        if lag.sites.peek_for(r_small).is_some_and(|t| t > site) {
                             // A new site is lower: the sequential loop would
                             // have taken it first.
                             lag.sites.push(site);
