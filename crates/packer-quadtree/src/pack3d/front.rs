@@ -727,7 +727,9 @@ pub(crate) struct Front3<'a> {
     kept: Vec<([f64; 3], u32, u32)>,
     /// Sites of one placement (sequential mode).
     batch: Vec<Site>,
-    last_block: usize,
+    /// Neighbour halos of the generating sphere as `[dx, dy, dz, (ρ −
+    /// tol)²]`, padded to a multiple of 4 with halos nothing enters.
+    halos: Vec<[f64; 4]>,
     /// `x` of the first sphere's wall side in a box (default: the box's
     /// `min.x`; a slab's left end).
     seed_x: Option<f64>,
@@ -774,7 +776,7 @@ impl<'a> Front3<'a> {
             local: Vec::with_capacity(128),
             kept: Vec::with_capacity(64),
             batch: Vec::with_capacity(64),
-            last_block: 0,
+            halos: Vec::with_capacity(64),
             seed_x: None,
             stats: Pack3Stats::default(),
         }
@@ -984,6 +986,15 @@ impl<'a> Front3<'a> {
                 }
             }
         }
+        self.halos.clear();
+        let tol = self.tol;
+        self.halos.extend(self.nb.iter().map(|o| {
+            let m = o.rho - tol;
+            [o.d[0], o.d[1], o.d[2], m * m]
+        }));
+        while self.halos.len() % 4 != 0 {
+            self.halos.push([f64::INFINITY, 0.0, 0.0, -1.0]);
+        }
         self.cands.clear();
         let nb = &self.nb;
         let n = nb.len();
@@ -1093,28 +1104,17 @@ impl<'a> Front3<'a> {
 
     /// `y` (relative to the generating sphere) outside every neighbour halo.
     #[inline]
-    fn free(&mut self, y: &[f64; 3]) -> bool {
-        let nb = &self.nb;
-        let n = nb.len();
-        if n == 0 {
-            return true;
-        }
-        let tol = self.tol;
-        let start = if self.last_block < n {
-            self.last_block
-        } else {
-            0
-        };
-        for k in 0..n {
-            let mut i = start + k;
-            if i >= n {
-                i -= n;
+    fn free(&self, y: &[f64; 3]) -> bool {
+        // Chunks of four halos without early exit inside a chunk (the
+        // compiler vectorises them); padding halos never hit.
+        let h = &self.halos;
+        for c in h.chunks_exact(4) {
+            let mut hit = false;
+            for o in c {
+                let (dx, dy, dz) = (y[0] - o[0], y[1] - o[1], y[2] - o[2]);
+                hit |= dx * dx + dy * dy + dz * dz < o[3];
             }
-            let o = &nb[i];
-            let (dx, dy, dz) = (y[0] - o.d[0], y[1] - o.d[1], y[2] - o.d[2]);
-            let m = o.rho - tol;
-            if dx * dx + dy * dy + dz * dz < m * m {
-                self.last_block = i;
+            if hit {
                 return false;
             }
         }
