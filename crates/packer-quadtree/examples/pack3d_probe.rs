@@ -20,7 +20,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Grading::Uniform { min: 1.0, max: 2.0 }
     };
     let dmax = grading.d_max();
-    let c = Container::walled_box(Vector3::new(side, side, side));
+    let c = if std::env::var("CYL").is_ok() {
+        Container::triaxial(side)
+    } else {
+        Container::walled_box(Vector3::new(side, side, side))
+    };
     let params = Pack3Params {
         lookahead: std::env::var("LA")
             .ok()

@@ -66,7 +66,9 @@
 //! size, and 3D sphere sizes of a grading are as uniform.
 //!
 //! **Slabs** ([`Pack3Params::slabs`], 4 in `default`, off in `dense`): a
-//! box at least 12 `d_max` wide is cut along `x` into slabs; the even slabs are
+//! box or cylinder at least 12 `d_max` wide is cut along `x` into slabs
+//! (a slab's first sphere sits in a corner of the box, or against the
+//! cylinder's side at the slab's middle); the even slabs are
 //! packed in parallel, each by its own front whose sites stop at the slab's
 //! faces, then the odd slabs in parallel against their packed neighbours.
 //! The sequential front fills the whole cross-section layer by layer, so
@@ -150,14 +152,14 @@ pub struct Pack3Params {
     /// Upper bound on the number of spheres (guards against a unit mistake
     /// exhausting memory; checked against the estimate before any work).
     pub max_particles: usize,
-    /// Slabs of the slab-parallel packing of a box by [`pack3d`] (`0` or
+    /// Slabs of the slab-parallel packing of a box or cylinder by [`pack3d`] (`0` or
     /// `1`: off; default 4, two per phase for two cores): the box is cut
     /// along `x` into this many slabs (fewer if a slab would be narrower
     /// than 6 `d_max`, even if the box is periodic in `x`), packed even
     /// ones first and odd ones against them, each phase in parallel (see
     /// the module docs). The count never depends on the thread count.
-    /// Cylinders, meshes and [`pack3d_sizes`] (whose size order is the
-    /// caller's) pack sequentially.
+    /// Meshes and [`pack3d_sizes`] (whose size order is the caller's) pack
+    /// sequentially.
     pub slabs: usize,
 }
 
@@ -263,15 +265,16 @@ pub fn pack3d(
         });
     }
     let n_slabs = slabs::slab_count(container, d_max, params.slabs);
-    if n_slabs > 1
-        && let Container::Box { min, max, periodic } = container
-    {
+    if n_slabs > 1 {
         let seed = rng.next_u64();
+        let (min, max) = container.bbox();
+        let periodic = container.periodic();
         return pack_slabbed(
             |order| slabs::SlabJob {
-                min: *min,
-                max: *max,
-                periodic: *periodic,
+                container,
+                min,
+                max,
+                periodic,
                 n: n_slabs,
                 d_lo: d_min,
                 d_hi: d_max,

@@ -730,8 +730,9 @@ pub(crate) struct Front3<'a> {
     /// Neighbour halos of the generating sphere as `[dx, dy, dz, (ρ −
     /// tol)²]`, padded to a multiple of 4 with halos nothing enters.
     halos: Vec<[f64; 4]>,
-    /// `x` of the first sphere's wall side in a box (default: the box's
-    /// `min.x`; a slab's left end).
+    /// `x` of the first sphere: its wall side in a box (default: the box's
+    /// `min.x`; a slab's left end), its centre in a cylinder (default: on
+    /// the `+x` side).
     seed_x: Option<f64>,
     pub(crate) stats: Pack3Stats,
 }
@@ -865,7 +866,17 @@ impl<'a> Front3<'a> {
                     planes,
                 },
                 _,
-            ) => Some([axis[0] + radius - r, axis[1], planes[0].o + r]),
+            ) => match self.seed_x {
+                // A slab's first sphere: against the side at `x` (the
+                // slab's middle), on the −y side.
+                Some(x) => {
+                    let rr = radius - r;
+                    let dx = x - axis[0];
+                    (dx.abs() < rr)
+                        .then(|| [x, axis[1] - (rr * rr - dx * dx).sqrt(), planes[0].o + r])
+                }
+                None => Some([axis[0] + radius - r, axis[1], planes[0].o + r]),
+            },
             (Walls::Mesh(mw), _) => {
                 // Lowest feasible corner of three face planes, among the
                 // planes facing most upwards.

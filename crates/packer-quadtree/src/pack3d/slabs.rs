@@ -1,4 +1,4 @@
-//! Slab-parallel packing of a box.
+//! Slab-parallel packing of a box or a cylinder.
 //!
 //! The box is cut along `x` into `n` slabs of equal width `W ≥ 6 d_max`.
 //! The even slabs are packed first, in parallel: each is a front of its
@@ -44,10 +44,15 @@ pub(super) const MIN_SLAB: f64 = 6.0;
 /// Number of slabs for a container: `requested`, lowered until every slab
 /// is at least `MIN_SLAB · d_max` wide and made even when the box is
 /// periodic in `x` (the last slab's neighbour is then the first); 1 (no
-/// slabs) for anything but a box, or when fewer than 2 remain.
+/// slabs) for a mesh, or when fewer than 2 remain.
 pub(super) fn slab_count(container: &Container, d_max: f64, requested: usize) -> usize {
-    let Container::Box { min, max, periodic } = container else {
-        return 1;
+    let (min, max, periodic) = match container {
+        Container::Box { min, max, periodic } => (*min, *max, *periodic),
+        Container::Cylinder { .. } => {
+            let (lo, hi) = container.bbox();
+            (lo, hi, [false; 2])
+        }
+        Container::Mesh(_) => return 1,
     };
     let fit = ((max.x - min.x) / (MIN_SLAB * d_max)).floor();
     let mut n = if fit.is_finite() && fit >= 0.0 {
@@ -63,6 +68,8 @@ pub(super) fn slab_count(container: &Container, d_max: f64, requested: usize) ->
 
 /// What one slab run needs.
 pub(super) struct SlabJob<'a> {
+    /// A box or a cylinder.
+    pub(super) container: &'a Container,
     pub(super) min: Point3<f64>,
     pub(super) max: Point3<f64>,
     pub(super) periodic: [bool; 2],
@@ -106,13 +113,25 @@ impl SlabJob<'_> {
         let wall_hi = !self.periodic[0] && j + 1 == self.n;
         let lo_x = if wall_lo { self.min.x } else { x0 - pad };
         let hi_x = if wall_hi { self.max.x } else { x1 + pad };
-        // The pads are empty space closed by walls no sphere reaches (a
-        // centre stays within r_max of its slab, walls are seen within
-        // 3 r_max of a generating sphere).
-        let sub = Container::Box {
-            min: Point3::new(lo_x, self.min.y, self.min.z),
-            max: Point3::new(hi_x, self.max.y, self.max.z),
-            periodic: [false, self.periodic[1]],
+        // A box slab: the pads are empty space closed by walls no sphere
+        // reaches (a centre stays within r_max of its slab, walls are seen
+        // within 3 r_max of a generating sphere). A cylinder slab: the
+        // whole cylinder, the sites cut to the slab.
+        let sub = match self.container {
+            Container::Box { .. } => Container::Box {
+                min: Point3::new(lo_x, self.min.y, self.min.z),
+                max: Point3::new(hi_x, self.max.y, self.max.z),
+                periodic: [false, self.periodic[1]],
+            },
+            c => c.clone(),
+        };
+        // The first sphere (even slabs): in the corner at the slab's left
+        // end (box), touching the floor and the side at the slab's middle
+        // (cylinder).
+        let seed_x = match self.container {
+            Container::Box { .. } if wall_lo => self.min.x,
+            Container::Box { .. } => x0,
+            _ => 0.5 * (x0 + x1),
         };
         let region = [
             if wall_lo { f64::NEG_INFINITY } else { x0 },
@@ -134,7 +153,7 @@ impl SlabJob<'_> {
             pipeline,
             Start {
                 region: Some(region),
-                seed_x: Some(if wall_lo { self.min.x } else { x0 }),
+                seed_x: Some(seed_x),
                 imported,
             },
         );

@@ -409,6 +409,11 @@ fn slab_packing_is_overlap_free_deterministic_and_dense() {
             max: Point3::new(50.0, 10.0, 10.0),
             periodic: [false, true],
         },
+        Container::Cylinder {
+            base: Point3::new(1.0, -2.0, 0.5),
+            radius: 18.0,
+            height: 12.0,
+        },
     ];
     let mut digests = Vec::new();
     for c in &boxes {
@@ -442,10 +447,11 @@ fn slab_packing_is_overlap_free_deterministic_and_dense() {
     }
     println!("slab golden {digests:x?}");
     assert_eq!(digests[0], SLAB_GOLDEN);
+    let prism = Container::mesh(prism_mesh(16, 40.0, 20.0)).expect("prism");
     assert_eq!(
-        slabs::slab_count(&Container::triaxial(100.0), 2.0, 4),
+        slabs::slab_count(&prism, 2.0, 4),
         1,
-        "cylinders pack sequentially"
+        "meshes pack sequentially"
     );
 }
 
