@@ -445,12 +445,14 @@ fn pack_checked(
             let mut f = front::Front3::new(container, 0.5 * lo, 0.5 * hi, sizes.len());
             let mut next = |k: usize| sizes.get(k).copied();
             f.run(
-                order,
                 &mut next,
-                params.max_particles,
-                params.lookahead,
-                params.max_skips,
-                params.pipeline && orders.len() == 1,
+                front::RunOpts {
+                    order,
+                    max: params.max_particles,
+                    lookahead: params.lookahead,
+                    max_skips: params.max_skips,
+                    pipeline: params.pipeline && orders.len() == 1,
+                },
                 front::Start::default(),
             );
             let stats = f.stats;

@@ -737,6 +737,18 @@ pub(crate) struct Front3<'a> {
     pub(crate) stats: Pack3Stats,
 }
 
+/// Settings of one front run (see [`crate::Pack3Params`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RunOpts {
+    pub(crate) order: FrontOrder,
+    /// Upper bound on the spheres held (imported ones included).
+    pub(crate) max: usize,
+    pub(crate) lookahead: usize,
+    pub(crate) max_skips: usize,
+    /// Site generation on a second thread.
+    pub(crate) pipeline: bool,
+}
+
 /// How a run starts: the whole container from a seed sphere (default), or
 /// one slab of a slab-parallel packing (sites restricted to `region`;
 /// `imported`: spheres of the neighbouring slabs, placed first as
@@ -1003,7 +1015,7 @@ impl<'a> Front3<'a> {
             let m = o.rho - tol;
             [o.d[0], o.d[1], o.d[2], m * m]
         }));
-        while self.halos.len() % 4 != 0 {
+        while !self.halos.len().is_multiple_of(4) {
             self.halos.push([f64::INFINITY, 0.0, 0.0, -1.0]);
         }
         self.cands.clear();
@@ -1269,14 +1281,17 @@ impl<'a> Front3<'a> {
     /// strict size order of the seed).
     pub(crate) fn run(
         &mut self,
-        order: FrontOrder,
         sizes: &mut dyn FnMut(usize) -> Option<f64>,
-        max: usize,
-        lookahead: usize,
-        max_skips: usize,
-        pipeline: bool,
+        opts: RunOpts,
         start: Start,
     ) {
+        let RunOpts {
+            order,
+            max,
+            lookahead,
+            max_skips,
+            pipeline,
+        } = opts;
         self.seed_x = start.seed_x;
         // Secondary key per order: lowest candidate (none), lowest
         // generating sphere, newest generating sphere (stack).

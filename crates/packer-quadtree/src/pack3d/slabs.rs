@@ -32,7 +32,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use super::container::Container;
-use super::front::{Front3, Pack3Stats, Start};
+use super::front::{Front3, Pack3Stats, RunOpts, Start};
 use crate::grading::Grading;
 use crate::packer::FrontOrder;
 
@@ -145,12 +145,14 @@ impl SlabJob<'_> {
         let grading = self.grading;
         let mut next = |_k: usize| Some(grading.sample(&mut rng));
         f.run(
-            self.order,
             &mut next,
-            self.max_particles.saturating_add(n_imp),
-            self.lookahead,
-            self.max_skips,
-            pipeline,
+            RunOpts {
+                order: self.order,
+                max: self.max_particles.saturating_add(n_imp),
+                lookahead: self.lookahead,
+                max_skips: self.max_skips,
+                pipeline,
+            },
             Start {
                 region: Some(region),
                 seed_x: Some(seed_x),
