@@ -1,5 +1,8 @@
 //! Probe of the 3D packer: density (centre-in-core estimate) and time.
-//! `cargo run --release --example pack3d_probe -- SIDE ORDER [mono]`
+//! `cargo run --release --example pack3d_probe -- SIDE ORDER [mono]`;
+//! env: `LA` look-ahead, `SLABS` slab count, `CYL` a triaxial cylinder of
+//! diameter SIDE, `CHECK` the independent checker, `XPROF=W` the solid
+//! fraction in x-bins of width W.
 #![allow(clippy::print_stdout)]
 use nalgebra::{Point3, Vector3};
 use packer_quadtree::{Container, FrontOrder, Grading, Pack3Params, pack3d_seeded};
@@ -77,9 +80,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let b0 = ((s.center.x - r) / w).floor().max(0.0) as usize;
             let b1 = (((s.center.x + r) / w).floor() as usize).min(nb - 1);
-            for b in b0..=b1 {
+            for (b, v) in bins.iter_mut().enumerate().take(b1 + 1).skip(b0) {
                 let (a, c) = (b as f64 * w - s.center.x, (b + 1) as f64 * w - s.center.x);
-                bins[b] += cum(c) - cum(a);
+                *v += cum(c) - cum(a);
             }
         }
         let area = (side - 2.0 * m) * (side - 2.0 * m);
