@@ -34,6 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .and_then(|s| s.parse().ok())
             .unwrap_or(8),
         front_order: order,
+        slab_cylinders: true,
         slabs: std::env::var("SLABS")
             .ok()
             .and_then(|s| s.parse().ok())

@@ -66,7 +66,8 @@
 //! size, and 3D sphere sizes of a grading are as uniform.
 //!
 //! **Slabs** ([`Pack3Params::slabs`], 4 in `default`, off in `dense`): a
-//! box or cylinder at least 12 `d_max` wide is cut along `x` into slabs
+//! box (a cylinder with [`Pack3Params::slab_cylinders`]) at least 12 `d_max`
+//! wide is cut along `x` into slabs
 //! (a slab's first sphere sits in a corner of the box, or against the
 //! cylinder's side at the slab's middle); the even slabs are
 //! packed in parallel, each by its own front whose sites stop at the slab's
@@ -152,7 +153,8 @@ pub struct Pack3Params {
     /// Upper bound on the number of spheres (guards against a unit mistake
     /// exhausting memory; checked against the estimate before any work).
     pub max_particles: usize,
-    /// Slabs of the slab-parallel packing of a box or cylinder by [`pack3d`] (`0` or
+    /// Slabs of the slab-parallel packing of a box (or cylinder, see
+    /// [`Pack3Params::slab_cylinders`]) by [`pack3d`] (`0` or
     /// `1`: off; default 4, two per phase for two cores): the box is cut
     /// along `x` into this many slabs (fewer if a slab would be narrower
     /// than 6 `d_max`, even if the box is periodic in `x`), packed even
@@ -161,6 +163,12 @@ pub struct Pack3Params {
     /// Meshes and [`pack3d_sizes`] (whose size order is the caller's) pack
     /// sequentially.
     pub slabs: usize,
+    /// Slabs in a cylinder too (default `false`): a slab face through the
+    /// specimen is a thin planar layering (see the module docs) that a
+    /// triaxial test should not have to meet; in the validate case
+    /// `pack3d/cylinder-h2d` it doubles the spread of the interior annuli's
+    /// fractions (0.006 → 0.020).
+    pub slab_cylinders: bool,
 }
 
 impl Default for Pack3Params {
@@ -172,6 +180,7 @@ impl Default for Pack3Params {
             pipeline: true,
             max_particles: 50_000_000,
             slabs: 4,
+            slab_cylinders: false,
         }
     }
 }
@@ -264,7 +273,10 @@ pub fn pack3d(
             limit: params.max_particles,
         });
     }
-    let n_slabs = slabs::slab_count(container, d_max, params.slabs);
+    let n_slabs = match container {
+        Container::Cylinder { .. } if !params.slab_cylinders => 1,
+        _ => slabs::slab_count(container, d_max, params.slabs),
+    };
     if n_slabs > 1 {
         let seed = rng.next_u64();
         let (min, max) = container.bbox();

@@ -390,6 +390,7 @@ proptest! {
 fn slab_packing_is_overlap_free_deterministic_and_dense() {
     let params = Pack3Params {
         slabs: 4,
+        slab_cylinders: true,
         ..Pack3Params::default()
     };
     let boxes = [
