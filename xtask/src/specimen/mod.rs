@@ -88,6 +88,8 @@ pub(crate) struct StageReport {
 }
 
 impl StageReport {
+    /// The stage named `name`.
+    #[cfg(test)]
     pub(crate) fn stage(&self, name: &str) -> Option<&Stage> {
         self.stages.iter().find(|s| s.name == name)
     }
@@ -176,9 +178,10 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
 
     // parents
     let t = Instant::now();
-    let (parents, note) = match &scene.parents {
+    let owned;
+    let (parents, note): (&cloner::Parents, String) = match &scene.parents {
         ParentsSpec::Ottawa => (
-            validate::grains::ottawa_parents()?,
+            ottawa()?,
             "71 embedded Ottawa-sand grains (spherical harmonics → level sets)".to_owned(),
         ),
         ParentsSpec::Files {
@@ -212,21 +215,22 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             let loaded = crate::parents::load(&args, &p).with_context(|| "`parents`".to_owned())?;
             let summary = loaded.summary(&p);
             let (parents, _, dna_s) = crate::parents::measure(loaded)?;
-            (parents, format!("{summary}, DNA {dna_s:.2} s"))
+            owned = parents;
+            (&owned, format!("{summary}, DNA {dna_s:.2} s"))
         }
     };
     st.ran("parents", t, note);
 
     // clone
     let t = Instant::now();
-    let mut params = cal.params.clone();
+    let mut params = cal.params;
     params.outputs = cloner::Outputs {
         level_set: false,
         dna: out.report,
     };
     let seed = scene.seed.unwrap_or(params.seed);
     params.seed = seed;
-    let model = CloneModel::fit(&parents, &params)?;
+    let model = CloneModel::fit(parents, &params)?;
     let count = scene.clones.count();
     let pb = crate::progress::bar("cloning", count, quiet);
     let cb = crate::progress::clone_callback(&pb);
@@ -584,7 +588,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 .zip(&scales)
                 .map(|(c, s)| equivalent(c) * s)
                 .collect();
-            let files = report::write(&parents, &run, &diameters, &scene.clones, &cal.name)?;
+            let files = report::write(parents, &run, &diameters, &scene.clones, &cal.name)?;
             for (name, bytes) in &files {
                 staging.write(name, bytes.as_bytes())?;
             }
@@ -617,6 +621,17 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     staging.write("report.txt", report.text().as_bytes())?;
     report.files = staging.commit(&out_dir)?;
     Ok(report)
+}
+
+/// The embedded Ottawa parents, built once per process (the tests run
+/// several scenes).
+fn ottawa() -> anyhow::Result<&'static cloner::Parents> {
+    static OTTAWA: std::sync::OnceLock<cloner::Parents> = std::sync::OnceLock::new();
+    if let Some(p) = OTTAWA.get() {
+        return Ok(p);
+    }
+    let p = validate::grains::ottawa_parents()?;
+    Ok(OTTAWA.get_or_init(|| p))
 }
 
 /// The per-grain products of the level-set stage.

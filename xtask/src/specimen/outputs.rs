@@ -69,11 +69,27 @@ impl Staging {
     }
 
     /// Moves every staged file into `out_dir` (renames within one file
-    /// system) and returns their paths relative to `out_dir`, sorted.
+    /// system; a staged folder such as `lsdem/` replaces the one already
+    /// there) and returns their paths relative to `out_dir`, sorted.
     pub(crate) fn commit(mut self, out_dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
         let mut files = self.files.lock().map(|f| f.clone()).unwrap_or_default();
         files.sort();
         files.dedup();
+        // an output folder of this run replaces the one of an earlier run
+        // (no stale grain files beside the new ones)
+        let mut folders: Vec<PathBuf> = files
+            .iter()
+            .filter(|f| f.components().count() > 1)
+            .filter_map(|f| f.components().next().map(|c| PathBuf::from(c.as_os_str())))
+            .collect();
+        folders.dedup();
+        for d in folders {
+            let old = out_dir.join(d);
+            if old.is_dir() {
+                std::fs::remove_dir_all(&old)
+                    .with_context(|| format!("replacing {}", old.display()))?;
+            }
+        }
         for rel in &files {
             let to = out_dir.join(rel);
             if let Some(d) = to.parent() {

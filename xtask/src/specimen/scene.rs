@@ -12,13 +12,13 @@
 //!     //       min_voxels: None, smoothing: None, sh_degree: None, resolution: 45)
 //!     parents: Ottawa,
 //!     calibrated: None,            // Some("my-sand.ron"); default fixtures/calibrated/gsc2-ottawa.ron
-//!     clones: Count(200),          // or Graded(count: 200, grading: "uniform:20,40"):
+//!     clones: Count(200),          // or Graded(count: 200, grading: "uniform:200,400"):
 //!                                  // each clone rescaled to a volume-equivalent diameter
 //!                                  // drawn from the grading (by number; `cargo xtask pack` syntax)
 //!     seed: None,                  // default: the calibrated seed
 //!     container: AutoCylinder(solid_fraction: 0.3),
-//!                                  // or Cylinder(diameter: 400.0, height: None) (H = 2 D),
-//!                                  // or Box(x: 300.0, y: 300.0, z: 300.0); lengths in the parents' unit
+//!                                  // or Cylinder(diameter: 3000.0, height: None) (H = 2 D),
+//!                                  // or Box(x: 2500.0, y: 2500.0, z: 2500.0); lengths in the parents' unit
 //!     preset: Default,             // or Dense (the sphere packer's presets)
 //!     level_set_resolution: 45,    // nodes per axis of each output level set
 //!     outputs: (

@@ -95,13 +95,14 @@ fn each_output_flag_changes_only_its_own_files() {
     );
     assert_eq!(base.files.len(), 2);
     // flag → the files it must add (every other file unchanged)
-    let cases: [(&str, &dyn Fn(&str) -> bool); 6] = [
-        ("lsdem: true", &|f| f.starts_with("lsdem/")),
-        ("lammps_clumps: true", &|f| f.starts_with("lammps/")),
-        ("liggghts_templates: true", &|f| f.starts_with("liggghts/")),
-        ("yade_clumps: true", &|f| f.starts_with("yade/")),
-        ("vtu: true", &|f| f == "specimen.vtu"),
-        ("report: true", &|f| {
+    type Owns = fn(&str) -> bool;
+    let cases: [(&str, Owns); 6] = [
+        ("lsdem: true", |f| f.starts_with("lsdem/")),
+        ("lammps_clumps: true", |f| f.starts_with("lammps/")),
+        ("liggghts_templates: true", |f| f.starts_with("liggghts/")),
+        ("yade_clumps: true", |f| f.starts_with("yade/")),
+        ("vtu: true", |f| f == "specimen.vtu"),
+        ("report: true", |f| {
             f == "report.md" || f.starts_with("plots/")
         }),
     ];
@@ -177,6 +178,17 @@ fn a_clumps_only_scene_skips_the_level_set_outputs() {
         text.contains("lsdem") && text.contains("skipped (no LS-DEM asked)"),
         "{text}"
     );
+    // a rerun into the same out_dir replaces its output folders (no stale files)
+    std::fs::write(out.join("lammps/stale.data"), "old").expect("plant a stale file");
+    run(&scene_text(
+        &config,
+        &out,
+        AUTO,
+        "lammps_clumps: true, clump: (spheres_per_clump: 10)",
+    ))
+    .expect("rerun");
+    assert!(!out.join("lammps/stale.data").exists());
+    assert!(out.join("lammps/clumps.data").exists());
     // nothing is rasterised when no output needs it
     let none = run(&scene_text(&config, &dir.join("none"), AUTO, "")).expect("no outputs");
     assert!(none.stage("level sets").expect("listed").skipped.is_some());
@@ -240,7 +252,7 @@ fn bad_scenes_name_the_key_or_file_and_write_nothing() {
         e.contains("`parents.path`") && e.contains("/no/such/grains"),
         "{e}"
     );
-    // a container too small for the largest clone (Ottawa clones are ~20-40 units)
+    // a container too small for the largest clone (Ottawa clones: bounding diameters ≈ 300-650)
     let e = bad(
         &dir,
         &scene_text(&config, &out, "Cylinder(diameter: 5.0)", "lsdem: true"),
@@ -252,7 +264,12 @@ fn bad_scenes_name_the_key_or_file_and_write_nothing() {
     // a container that cannot take every clone
     let e = bad(
         &dir,
-        &scene_text(&config, &out, "Box(x: 80.0, y: 80.0, z: 80.0)", "vtu: true"),
+        &scene_text(
+            &config,
+            &out,
+            "Box(x: 700.0, y: 700.0, z: 700.0)",
+            "vtu: true",
+        ),
     );
     assert!(e.contains("cannot take all 20 clones"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
@@ -276,13 +293,13 @@ fn grains_stay_inside_their_bounding_spheres() {
     let config = cheap_config(&dir);
     let text = std::fs::read_to_string(config).expect("config");
     let cal = cloner::Calibrated::from_ron(&text).expect("parses");
-    let parents = validate::grains::ottawa_parents().expect("parents");
+    let parents = super::ottawa().expect("parents");
     let mut params = cal.params;
     params.outputs = cloner::Outputs {
         level_set: false,
         dna: false,
     };
-    let model = cloner::CloneModel::fit(&parents, &params).expect("fit");
+    let model = cloner::CloneModel::fit(parents, &params).expect("fit");
     let run = model.run(0..20, cloner::Hooks::default()).expect("run");
     let mut worst = 0.0_f64;
     for c in &run.clones {
