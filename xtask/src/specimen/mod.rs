@@ -213,7 +213,15 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 resolution: *resolution,
             };
             let loaded = crate::parents::load(&args, &p).with_context(|| "`parents`".to_owned())?;
-            let summary = loaded.summary(&p);
+            let summary = format!(
+                "{}{}",
+                loaded.summary(&p),
+                if loaded.format == crate::parents::InputFormat::Anm {
+                    ", spherical harmonics → level sets"
+                } else {
+                    ", level sets (no spherical harmonics)"
+                }
+            );
             let (parents, _, dna_s) = crate::parents::measure(loaded)?;
             owned = parents;
             (&owned, format!("{summary}, DNA {dna_s:.2} s"))
