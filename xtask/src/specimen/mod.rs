@@ -375,6 +375,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         let t = Instant::now();
         let res = scene.level_set_resolution;
         let clump_params = out.clump.params();
+        let lsdem_h = lsdem_spacing(scene, &run, &scales, params.grid_margin);
         let mut vtu = if out.vtu {
             let p = staging.path("specimen.vtu")?;
             let f =
@@ -400,7 +401,9 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                     ns[0].fetch_add((t1 - t0).as_nanos() as u64, Ordering::Relaxed);
                     let mut g = GrainOut::default();
                     if out.lsdem {
-                        let m = levelset::io::MorphFile::from_grid(&grid, 1.0, out.lsdem_nodes)
+                        let common = resample(&grid, lsdem_h)
+                            .with_context(|| format!("LS-DEM grid of clone {}", c.index))?;
+                        let m = levelset::io::MorphFile::from_grid(&common, 1.0, out.lsdem_nodes)
                             .with_context(|| format!("LS-DEM morph of clone {}", c.index))?;
                         let file = format!("grain-{:06}.dat", c.index);
                         let path = staging.path(&format!("lsdem/{file}"))?;
@@ -408,8 +411,8 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                             .with_context(|| format!("creating {}", path.display()))?;
                         levelset::io::write_morph(BufWriter::new(f), &m)
                             .with_context(|| format!("writing {}", path.display()))?;
-                        let h = grid.spacing();
-                        let com = grid.origin() + m.centroid.coords * h;
+                        let h = common.spacing();
+                        let com = common.origin() + m.centroid.coords * h;
                         g.lsdem = Some(LsdemPose {
                             index: c.index,
                             file,
@@ -501,13 +504,22 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 "lsdem/poses.txt",
                 outputs::lsdem_poses(&lsdem_poses).as_bytes(),
             )?;
+            staging.write(
+                "lsdem/positions.dat",
+                outputs::lsdem_positions(&lsdem_poses).as_bytes(),
+            )?;
+            staging.write(
+                "lsdem/morphID.dat",
+                outputs::lsdem_morph_ids(&lsdem_poses).as_bytes(),
+            )?;
             st.ran_s(
                 "lsdem",
                 cpu(1) + t.elapsed().as_secs_f64(),
                 format!(
-                    "{} morph files ({} surface nodes) + lsdem/poses.txt (CPU)",
+                    "{} morph files ({} surface nodes, one grid unit = {:.4}) + poses.txt, positions.dat, morphID.dat (CPU)",
                     lsdem_poses.len(),
-                    out.lsdem_nodes
+                    out.lsdem_nodes,
+                    lsdem_poses.first().map_or(f64::NAN, |p| p.spacing)
                 ),
             );
         }
@@ -640,6 +652,38 @@ fn ottawa() -> anyhow::Result<&'static cloner::Parents> {
     }
     let p = validate::grains::ottawa_parents()?;
     Ok(OTTAWA.get_or_init(|| p))
+}
+
+/// The one grid spacing of the LS-DEM morph files: the scene's, or the
+/// median of the grains' own spacings (`2 · margin · r_max / (res − 1)`).
+fn lsdem_spacing(scene: &Scene, run: &cloner::Run, scales: &[f64], margin: f64) -> f64 {
+    if let Some(h) = scene.outputs.lsdem_spacing {
+        return h;
+    }
+    let res = scene.level_set_resolution as f64;
+    let mut own: Vec<f64> = run
+        .clones
+        .iter()
+        .zip(scales)
+        .map(|(c, s)| 2.0 * margin * c.surface.r_max * s / (res - 1.0))
+        .collect();
+    own.sort_by(f64::total_cmp);
+    own.get(own.len() / 2).copied().unwrap_or(1.0)
+}
+
+/// `grid` resampled (trilinear) at spacing `h` over the same box, so that
+/// every morph file shares one grid unit.
+fn resample(grid: &levelset::Grid, h: f64) -> anyhow::Result<levelset::Grid> {
+    let lo = grid.origin();
+    let d = grid.dims();
+    let extent = (d[0].max(d[1]).max(d[2]) - 1) as f64 * grid.spacing();
+    let n = ((extent / h).ceil() as usize + 1).max(3);
+    let spec = levelset::GridSpec {
+        dims: [n, n, n],
+        origin: lo,
+        spacing: h,
+    };
+    Ok(levelset::Grid::from_fn(spec, |p| grid.value(p))?)
 }
 
 /// The per-grain products of the level-set stage.

@@ -129,8 +129,9 @@ pub(crate) fn lsdem_poses(poses: &[LsdemPose]) -> String {
          # id morph_file x y z q0 q1 q2 q3 spacing\n\
          # x y z: the grain's centre of mass in the world (scene length unit);\n\
          # q0 q1 q2 q3: unit quaternion (scalar first) rotating the morph file's axes to the world;\n\
-         # spacing: world length of one grid unit of that morph file (morph files use spacing 1),\n\
-         # so a morph point p (relative to the centre of mass, grid units) is at x + R(q) * spacing * p.\n",
+         # spacing: world length of one grid unit (the same for every morph file: they use spacing 1),\n\
+         # so a morph point p (relative to the centre of mass, grid units) is at x + R(q) * spacing * p.\n\
+         # positions.dat holds x y z / spacing (grid units), one grain per line, morphID.dat the file numbers.\n",
     );
     for p in poses {
         let q = p.pose.rotation.quaternion();
@@ -139,6 +140,28 @@ pub(crate) fn lsdem_poses(poses: &[LsdemPose]) -> String {
             "{} {} {:e} {:e} {:e} {:e} {:e} {:e} {:e} {:e}",
             p.index, p.file, p.centre.x, p.centre.y, p.centre.z, q.w, q.i, q.j, q.k, p.spacing
         );
+    }
+    s
+}
+
+/// `lsdem/positions.dat`: `x y z` of every centre of mass in grid units
+/// (world / spacing), one grain per line, no header (what LS-DEM codes read
+/// with their position-file readers).
+pub(crate) fn lsdem_positions(poses: &[LsdemPose]) -> String {
+    let mut s = String::new();
+    for p in poses {
+        let c = p.centre.coords / p.spacing;
+        let _ = writeln!(s, "{:e} {:e} {:e}", c.x, c.y, c.z);
+    }
+    s
+}
+
+/// `lsdem/morphID.dat`: the morph file number (`grain-NNNNNN.dat`) of every
+/// line of `positions.dat`.
+pub(crate) fn lsdem_morph_ids(poses: &[LsdemPose]) -> String {
+    let mut s = String::new();
+    for p in poses {
+        let _ = writeln!(s, "{}", p.index);
     }
     s
 }

@@ -24,6 +24,7 @@
 //!     outputs: (
 //!         lsdem: false,            // LS-DEM morph files + poses
 //!         lsdem_nodes: 1000,       // surface nodes per morph file
+//!         lsdem_spacing: None,     // one grid spacing for all morph files (default: the median grain's)
 //!         lammps_clumps: true,     // LAMMPS data of all clump spheres + body ids
 //!         liggghts_templates: false, // LIGGGHTS particletemplate/multisphere files
 //!         yade_clumps: false,      // Yade clump list + loader script
@@ -198,6 +199,10 @@ pub(crate) struct Outputs {
     pub(crate) lsdem: bool,
     /// Surface nodes per morph file.
     pub(crate) lsdem_nodes: usize,
+    /// One grid spacing for every morph file, in the scene's length unit
+    /// (LS-DEM works in one grid unit): default the median of the grains'
+    /// own spacings at `level_set_resolution`.
+    pub(crate) lsdem_spacing: Option<f64>,
     /// LAMMPS data file of every clump sphere + the body-id file.
     pub(crate) lammps_clumps: bool,
     /// LIGGGHTS `particletemplate/multisphere` templates.
@@ -219,6 +224,7 @@ impl Default for Outputs {
         Self {
             lsdem: false,
             lsdem_nodes: 1000,
+            lsdem_spacing: None,
             lammps_clumps: false,
             liggghts_templates: false,
             yade_clumps: false,
@@ -336,6 +342,9 @@ impl Scene {
             bail!("{at}: `outputs.lsdem_nodes` must be at least 1");
         }
         positive("outputs.density", self.outputs.density)?;
+        if let Some(h) = self.outputs.lsdem_spacing {
+            positive("outputs.lsdem_spacing", h)?;
+        }
         if self.outputs.clumps() {
             self.outputs
                 .clump

@@ -125,10 +125,26 @@ fn each_output_flag_changes_only_its_own_files() {
     // specific contents
     let lsdem = files_under(&dir.join("flag-0"));
     assert_eq!(
-        lsdem.iter().filter(|f| f.ends_with(".dat")).count(),
+        lsdem.iter().filter(|f| f.starts_with("lsdem/grain-")).count(),
         20,
         "one morph file per grain"
     );
+    // one grid unit for every morph file; positions in that unit
+    let poses = std::fs::read_to_string(dir.join("flag-0/lsdem/poses.txt")).expect("poses");
+    let spacings: BTreeSet<String> = poses
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .filter_map(|l| l.split_whitespace().last().map(String::from))
+        .collect();
+    assert_eq!(spacings.len(), 1, "{spacings:?}");
+    let positions =
+        std::fs::read_to_string(dir.join("flag-0/lsdem/positions.dat")).expect("positions");
+    assert_eq!(positions.lines().count(), 20);
+    let morph = levelset::io::read_morph(std::io::BufReader::new(
+        std::fs::File::open(dir.join("flag-0/lsdem/grain-000000.dat")).expect("morph"),
+    ))
+    .expect("the morph file reads back");
+    assert!(morph.mass > 0.0 && morph.points.len() == 1000);
     let body = std::fs::read_to_string(dir.join("flag-1/lammps/clumps.body")).expect("body");
     let data = packer_quadtree::read_lammps_data3(std::io::BufReader::new(
         std::fs::File::open(dir.join("flag-1/lammps/clumps.data")).expect("data"),
