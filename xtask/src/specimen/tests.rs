@@ -125,7 +125,10 @@ fn each_output_flag_changes_only_its_own_files() {
     // specific contents
     let lsdem = files_under(&dir.join("flag-0"));
     assert_eq!(
-        lsdem.iter().filter(|f| f.starts_with("lsdem/grain-")).count(),
+        lsdem
+            .iter()
+            .filter(|f| f.starts_with("lsdem/grain-"))
+            .count(),
         20,
         "one morph file per grain"
     );
