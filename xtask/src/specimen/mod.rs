@@ -565,7 +565,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         Some(r) => st.skip("liggghts", &r),
         None => {
             let t = Instant::now();
-            let (files, script) = outputs::liggghts_templates(&clumps);
+            let (files, script) = outputs::liggghts_templates(&clumps, out.density);
             for (name, text) in &files {
                 staging.write(&format!("liggghts/{name}"), text.as_bytes())?;
             }

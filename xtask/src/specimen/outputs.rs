@@ -247,12 +247,16 @@ print('grainforge: %d clumps loaded' % len(clumps))
 /// per sphere, clone frame) and `liggghts/templates.in` with the
 /// `particletemplate/multisphere` fixes and a discrete distribution of
 /// them (equal weights).
-pub(crate) fn liggghts_templates(clumps: &[PlacedClump]) -> (Vec<(String, String)>, String) {
+pub(crate) fn liggghts_templates(
+    clumps: &[PlacedClump],
+    density: f64,
+) -> (Vec<(String, String)>, String) {
     let mut files = Vec::new();
     let mut script = String::from(
         "# grainforge specimen: LIGGGHTS multisphere templates, one per clone.\n\
          # include this file from the LIGGGHTS input (paths are relative to out_dir/liggghts);\n\
-         # set the density and atom type to yours. The placed poses are in ../poses.csv.\n",
+         # density = the scene's `outputs.density`; one multisphere type per template.\n\
+         # The placed poses are in ../poses.csv.\n",
     );
     let n = clumps.len();
     for (k, c) in clumps.iter().enumerate() {
@@ -263,9 +267,10 @@ pub(crate) fn liggghts_templates(clumps: &[PlacedClump]) -> (Vec<(String, String
         }
         let _ = writeln!(
             script,
-            "fix pts{} all particletemplate/multisphere 15485863 atom_type 1 density constant 2500 nspheres {} ntry 1000000 spheres file {name} scale 1.0 type 1",
+            "fix pts{} all particletemplate/multisphere 15485863 atom_type 1 density constant {density} nspheres {} ntry 1000000 spheres file {name} scale 1.0 type {}",
             k + 1,
-            c.spheres.len()
+            c.spheres.len(),
+            k + 1
         );
         files.push((name, t));
     }
