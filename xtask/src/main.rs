@@ -6,7 +6,9 @@
 //! validate [--filter PATTERN] [--report DIR] [--fast]` runs the reference
 //! cases of the `validate` crate, prints the result table and exits non-zero
 //! on failure; `cargo xtask pack` packs a 2D domain with disks and writes it
-//! for DEM tools; `cargo xtask dna` and `convergence` write generated tables.
+//! for DEM tools; `cargo xtask specimen SCENE.ron` builds a DEM specimen of
+//! cloned grains from a scene file; `cargo xtask dna` and `convergence`
+//! write generated tables.
 //! The tidy checks of the workspace are `#[test]`s in `tidy.rs`, run by
 //! `cargo test`.
 //!
@@ -26,6 +28,7 @@ mod pack3d_cmd;
 mod pack_cmd;
 mod parents;
 mod progress;
+mod specimen;
 mod svg;
 mod synth_scan;
 mod validate_cmd;
@@ -59,6 +62,11 @@ enum Command {
     /// container with spheres (`--dim 3 --container …`) and write CSV, VTU
     /// (ParaView), LIGGGHTS/LAMMPS data, Yade text (and SVG in 2D).
     Pack(pack_cmd::Pack),
+    /// Build a DEM specimen of cloned grains from a scene file (RON):
+    /// parents, calibrated configuration, clones, container, packing preset
+    /// and outputs (LS-DEM, LAMMPS/LIGGGHTS/Yade clumps, VTU, DNA and
+    /// grading report); only the stages the scene needs run.
+    Specimen(specimen::Specimen),
     /// Write a synthetic labelled CT image of cloned grains (scale tests of
     /// `--parents`).
     SynthScan(synth_scan::SynthScan),
@@ -90,6 +98,7 @@ fn main() -> anyhow::Result<()> {
         Command::Convergence(cmd) => cmd.run(&workspace_root()),
         Command::Pack(cmd) => cmd.run(&workspace_root()),
         Command::SynthScan(cmd) => cmd.run(&workspace_root()),
+        Command::Specimen(cmd) => cmd.run(&workspace_root()),
     }
 }
 

@@ -29,7 +29,7 @@ use levelset::Grid;
 use rayon::prelude::*;
 
 /// The input formats of `--parents`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, serde::Deserialize)]
 pub(crate) enum InputFormat {
     /// NumPy `.npy` labelled image.
     Npy,

@@ -1,0 +1,362 @@
+//! The scene file of `cargo xtask specimen SCENE.ron`: its schema, parsing
+//! (RON, every struct and enum refuses unknown keys) and validation.
+//!
+//! Schema (every key but `clones` and `container` may be left out; relative
+//! paths are relative to the workspace root, as every xtask path):
+//!
+//! ```ron
+//! Scene(
+//!     // the embedded 71 Ottawa-sand grains (default), or any input of `--parents`:
+//!     // Files(path: "fixtures/grains/vcctl/MA107-6-fine", format: Some(Anm), spacing: None,
+//!     //       raw_dims: None, raw_dtype: None, big_endian: false, keep_border: false,
+//!     //       min_voxels: None, smoothing: None, sh_degree: None, resolution: 45)
+//!     parents: Ottawa,
+//!     calibrated: None,            // Some("my-sand.ron"); default fixtures/calibrated/gsc2-ottawa.ron
+//!     clones: Count(200),          // or Graded(count: 200, grading: "uniform:200,400"):
+//!                                  // each clone rescaled to a volume-equivalent diameter
+//!                                  // drawn from the grading (by number; `cargo xtask pack` syntax)
+//!     seed: None,                  // default: the calibrated seed
+//!     container: AutoCylinder(solid_fraction: 0.3),
+//!                                  // or Cylinder(diameter: 3000.0, height: None) (H = 2 D),
+//!                                  // or Box(x: 2500.0, y: 2500.0, z: 2500.0); lengths in the parents' unit
+//!     preset: Default,             // or Dense (the sphere packer's presets)
+//!     level_set_resolution: 45,    // nodes per axis of each output level set
+//!     outputs: (
+//!         lsdem: false,            // LS-DEM morph files + poses
+//!         lsdem_nodes: 1000,       // surface nodes per morph file
+//!         lsdem_spacing: None,     // one grid spacing for all morph files (default: the median grain's)
+//!         lammps_clumps: true,     // LAMMPS data of all clump spheres + body ids
+//!         liggghts_templates: false, // LIGGGHTS particletemplate/multisphere files
+//!         yade_clumps: false,      // Yade clump list + loader script
+//!         clump: (spheres_per_clump: 20, overlap: 0.6),
+//!         density: 1.0,            // mass per volume written to the LAMMPS data file
+//!         vtu: false,              // marching-cubes surfaces of every placed grain (ParaView)
+//!         report: false,           // DNA and grading report with SVG plots
+//!     ),
+//!     out_dir: "target/specimen",
+//! )
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use serde::Deserialize;
+
+use crate::parents::InputFormat;
+
+/// A specimen scene.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Scene {
+    /// Where the parents come from.
+    #[serde(default)]
+    pub(crate) parents: ParentsSpec,
+    /// The calibrated cloner configuration (default: the committed Ottawa one).
+    #[serde(default)]
+    pub(crate) calibrated: Option<PathBuf>,
+    /// How many clones, and their sizes.
+    pub(crate) clones: Clones,
+    /// Master seed (default: the calibrated configuration's).
+    #[serde(default)]
+    pub(crate) seed: Option<u64>,
+    /// The container.
+    pub(crate) container: ContainerSpec,
+    /// The packer preset.
+    #[serde(default)]
+    pub(crate) preset: Preset,
+    /// Nodes per axis of every output level set.
+    #[serde(default = "default_resolution")]
+    pub(crate) level_set_resolution: usize,
+    /// What to write.
+    #[serde(default)]
+    pub(crate) outputs: Outputs,
+    /// Output folder.
+    #[serde(default = "default_out_dir")]
+    pub(crate) out_dir: PathBuf,
+}
+
+fn default_resolution() -> usize {
+    45
+}
+
+fn default_out_dir() -> PathBuf {
+    PathBuf::from("target/specimen")
+}
+
+/// Where the parents come from.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) enum ParentsSpec {
+    /// The embedded 71 Ottawa-sand grains (spherical harmonics → level sets).
+    #[default]
+    Ottawa,
+    /// Any input of `--parents` (see `parents.rs`).
+    Files {
+        /// A labelled image file or a directory of per-grain files.
+        path: PathBuf,
+        /// Input format (default: from the extension and contents).
+        #[serde(default)]
+        format: Option<InputFormat>,
+        /// Voxel spacing of a labelled image.
+        #[serde(default)]
+        spacing: Option<f64>,
+        /// Raw image dimensions (x fastest).
+        #[serde(default)]
+        raw_dims: Option<(usize, usize, usize)>,
+        /// Raw voxel type (u8, u16, u32, i32, i64).
+        #[serde(default)]
+        raw_dtype: Option<String>,
+        /// Raw image is big-endian.
+        #[serde(default)]
+        big_endian: bool,
+        /// Keep grains touching the image border.
+        #[serde(default)]
+        keep_border: bool,
+        /// Skip labels with fewer voxels.
+        #[serde(default)]
+        min_voxels: Option<usize>,
+        /// Gaussian smoothing σ in voxels.
+        #[serde(default)]
+        smoothing: Option<f64>,
+        /// Spherical-harmonic degree of `anm` files.
+        #[serde(default)]
+        sh_degree: Option<usize>,
+        /// Level-set nodes per axis for mesh and SH grains.
+        #[serde(default = "default_resolution")]
+        resolution: usize,
+    },
+}
+
+/// Number (and sizes) of the clones.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) enum Clones {
+    /// `count` clones at the sizes the cloner draws (the parents' sizes).
+    Count(u64),
+    /// `count` clones, each rescaled to a volume-equivalent diameter drawn
+    /// (by number) from `grading` (`cargo xtask pack --grading` syntax).
+    Graded {
+        /// Number of clones.
+        count: u64,
+        /// The grading, e.g. `"uniform:20,40"`.
+        grading: String,
+    },
+}
+
+impl Clones {
+    pub(crate) fn count(&self) -> u64 {
+        match self {
+            Self::Count(n) | Self::Graded { count: n, .. } => *n,
+        }
+    }
+}
+
+/// The container; lengths in the parents' unit.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) enum ContainerSpec {
+    /// A walled cylinder with its axis along z and its base at the origin
+    /// (H = 2 D, the triaxial specimen, unless `height` is given).
+    Cylinder {
+        /// Inner diameter.
+        diameter: f64,
+        /// Inner height (default 2 × diameter).
+        #[serde(default)]
+        height: Option<f64>,
+    },
+    /// A cylinder with H/D = 2 sized so that the clones' bounding spheres
+    /// fill `solid_fraction` of it, grown by 5 % until every clone fits.
+    AutoCylinder {
+        /// Target solid fraction of the bounding spheres, in (0, 0.6].
+        solid_fraction: f64,
+    },
+    /// A walled box `[0, x] × [0, y] × [0, z]`.
+    Box {
+        /// Side along x.
+        x: f64,
+        /// Side along y.
+        y: f64,
+        /// Side along z.
+        z: f64,
+    },
+}
+
+/// The sphere packer's preset.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+pub(crate) enum Preset {
+    /// `Pack3Params::default()`.
+    #[default]
+    Default,
+    /// `Pack3Params::dense()`.
+    Dense,
+}
+
+/// What to write.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(crate) struct Outputs {
+    /// LS-DEM morph files and the poses file.
+    pub(crate) lsdem: bool,
+    /// Surface nodes per morph file.
+    pub(crate) lsdem_nodes: usize,
+    /// One grid spacing for every morph file, in the scene's length unit
+    /// (LS-DEM works in one grid unit): default the median of the grains'
+    /// own spacings at `level_set_resolution`.
+    pub(crate) lsdem_spacing: Option<f64>,
+    /// LAMMPS data file of every clump sphere + the body-id file.
+    pub(crate) lammps_clumps: bool,
+    /// LIGGGHTS `particletemplate/multisphere` templates.
+    pub(crate) liggghts_templates: bool,
+    /// Yade clump list and loader script.
+    pub(crate) yade_clumps: bool,
+    /// Clump parameters shared by the three clump outputs.
+    pub(crate) clump: ClumpSpec,
+    /// Mass per volume in the LAMMPS data file.
+    pub(crate) density: f64,
+    /// VTU of the marching-cubes surfaces of every placed grain.
+    pub(crate) vtu: bool,
+    /// DNA (clones vs parents) and grading report with SVG plots.
+    pub(crate) report: bool,
+}
+
+impl Default for Outputs {
+    fn default() -> Self {
+        Self {
+            lsdem: false,
+            lsdem_nodes: 1000,
+            lsdem_spacing: None,
+            lammps_clumps: false,
+            liggghts_templates: false,
+            yade_clumps: false,
+            clump: ClumpSpec::default(),
+            density: 1.0,
+            vtu: false,
+            report: false,
+        }
+    }
+}
+
+impl Outputs {
+    /// Any of the three clump outputs.
+    pub(crate) fn clumps(&self) -> bool {
+        self.lammps_clumps || self.liggghts_templates || self.yade_clumps
+    }
+
+    /// Any output that needs a level set per grain.
+    pub(crate) fn level_sets(&self) -> bool {
+        self.lsdem || self.clumps() || self.vtu
+    }
+}
+
+/// Multi-sphere clump parameters (`levelset::ClumpParams`).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(crate) struct ClumpSpec {
+    /// Spheres per clump (at most; CLUMP's `N`).
+    pub(crate) spheres_per_clump: usize,
+    /// Overlap in [0, 1) (CLUMP's `overlap`).
+    pub(crate) overlap: f64,
+}
+
+impl Default for ClumpSpec {
+    fn default() -> Self {
+        Self {
+            spheres_per_clump: 20,
+            overlap: 0.6,
+        }
+    }
+}
+
+impl ClumpSpec {
+    pub(crate) fn params(&self) -> levelset::ClumpParams {
+        levelset::ClumpParams {
+            n_spheres: self.spheres_per_clump,
+            overlap: self.overlap,
+            ..levelset::ClumpParams::default()
+        }
+    }
+}
+
+impl Scene {
+    /// Parses a scene; errors carry `line:column` and the offending key.
+    pub(crate) fn parse(text: &str, source: &Path) -> anyhow::Result<Self> {
+        let scene: Self =
+            ron::from_str(text).map_err(|e| anyhow::anyhow!("{}:{e}", source.display()))?;
+        scene.validate(source)?;
+        Ok(scene)
+    }
+
+    /// Reads and parses a scene file.
+    pub(crate) fn read(path: &Path) -> anyhow::Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("reading the scene {}", path.display()))?;
+        Self::parse(&text, path)
+    }
+
+    /// Checks values that the schema cannot (files are checked where they
+    /// are read, with the key in the message).
+    fn validate(&self, source: &Path) -> anyhow::Result<()> {
+        let at = source.display();
+        if self.clones.count() == 0 {
+            bail!("{at}: `clones`: the count must be at least 1, got 0");
+        }
+        if let Clones::Graded { grading, .. } = &self.clones {
+            let g = crate::pack_cmd::parse_grading(grading)
+                .with_context(|| format!("{at}: `clones.grading`"))?;
+            g.validate()
+                .with_context(|| format!("{at}: `clones.grading` `{grading}`"))?;
+        }
+        let positive = |key: &str, v: f64| -> anyhow::Result<()> {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("{at}: `{key}` must be positive and finite, got {v}");
+            }
+            Ok(())
+        };
+        match &self.container {
+            ContainerSpec::Cylinder { diameter, height } => {
+                positive("container.diameter", *diameter)?;
+                if let Some(h) = height {
+                    positive("container.height", *h)?;
+                }
+            }
+            ContainerSpec::AutoCylinder { solid_fraction } => {
+                if !(*solid_fraction > 0.0 && *solid_fraction <= 0.6) {
+                    bail!(
+                        "{at}: `container.solid_fraction` must be in (0, 0.6], got {solid_fraction}"
+                    );
+                }
+            }
+            ContainerSpec::Box { x, y, z } => {
+                positive("container.x", *x)?;
+                positive("container.y", *y)?;
+                positive("container.z", *z)?;
+            }
+        }
+        if !(5..=400).contains(&self.level_set_resolution) {
+            bail!(
+                "{at}: `level_set_resolution` must be in 5..=400, got {}",
+                self.level_set_resolution
+            );
+        }
+        if self.outputs.lsdem && self.outputs.lsdem_nodes == 0 {
+            bail!("{at}: `outputs.lsdem_nodes` must be at least 1");
+        }
+        positive("outputs.density", self.outputs.density)?;
+        if let Some(h) = self.outputs.lsdem_spacing {
+            positive("outputs.lsdem_spacing", h)?;
+        }
+        if self.outputs.clumps() {
+            self.outputs
+                .clump
+                .params()
+                .validate()
+                .with_context(|| format!("{at}: `outputs.clump`"))?;
+        }
+        if let ParentsSpec::Files { resolution, .. } = &self.parents
+            && !(5..=400).contains(resolution)
+        {
+            bail!("{at}: `parents.resolution` must be in 5..=400, got {resolution}");
+        }
+        Ok(())
+    }
+}

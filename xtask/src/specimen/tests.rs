@@ -1,0 +1,340 @@
+//! Tests of `cargo xtask specimen`: each output flag changes only its own
+//! files, a clumps-only scene skips the level-set output stage, and bad
+//! input is an error naming the key or file with nothing left in `out_dir`.
+//!
+//! Small and fast: 20 clones of a cheap configuration (the calibrated
+//! Ottawa one with a 25³ level set, 16 pilot clones and no level-set
+//! roundness check) at a 21³ output resolution.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use super::scene::Scene;
+use super::{StageReport, run_scene};
+
+fn root() -> PathBuf {
+    crate::workspace_root()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("grainforge-specimen-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+/// A cheap calibrated configuration in `dir` (test speed only).
+fn cheap_config(dir: &Path) -> PathBuf {
+    let path = root().join("fixtures/calibrated/gsc2-ottawa.ron");
+    let text = std::fs::read_to_string(path).expect("calibrated fixture");
+    let mut cal = cloner::Calibrated::from_ron(&text).expect("parses");
+    cal.params.level_set_resolution = 25;
+    cal.params.pilot_clones = 16;
+    cal.params.roundness_tolerance = None;
+    cal.params.roundness_repairs = 0;
+    cal.params.roundness_predictions = 0;
+    let p = dir.join("cheap.ron");
+    std::fs::write(&p, cal.to_ron().expect("ron")).expect("write config");
+    p
+}
+
+/// A scene of 20 cheap clones with the given outputs (RON fragment).
+fn scene_text(config: &Path, out_dir: &Path, container: &str, outputs: &str) -> String {
+    format!(
+        r#"Scene(
+    calibrated: Some("{}"),
+    clones: Count(20),
+    seed: Some(3),
+    container: {container},
+    level_set_resolution: 21,
+    outputs: ({outputs}),
+    out_dir: "{}",
+)"#,
+        config.display(),
+        out_dir.display()
+    )
+}
+
+fn run(text: &str) -> anyhow::Result<StageReport> {
+    let scene = Scene::parse(text, Path::new("test.ron"))?;
+    run_scene(&scene, &root(), true)
+}
+
+fn files_under(dir: &Path) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let Ok(rd) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in rd.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if let Ok(rel) = p.strip_prefix(dir) {
+                out.insert(rel.to_string_lossy().into_owned());
+            }
+        }
+    }
+    out
+}
+
+const AUTO: &str = "AutoCylinder(solid_fraction: 0.3)";
+
+#[test]
+fn each_output_flag_changes_only_its_own_files() {
+    let dir = tmp("flags");
+    let config = cheap_config(&dir);
+    let base_dir = dir.join("base");
+    let base = run(&scene_text(&config, &base_dir, AUTO, "")).expect("base scene");
+    let base_files = files_under(&base_dir);
+    assert_eq!(
+        base_files,
+        ["poses.csv", "report.txt"].map(String::from).into(),
+        "{base_files:?}"
+    );
+    assert_eq!(base.files.len(), 2);
+    // flag → the files it must add (every other file unchanged)
+    type Owns = fn(&str) -> bool;
+    let cases: [(&str, Owns); 6] = [
+        ("lsdem: true", |f| f.starts_with("lsdem/")),
+        ("lammps_clumps: true", |f| f.starts_with("lammps/")),
+        ("liggghts_templates: true", |f| f.starts_with("liggghts/")),
+        ("yade_clumps: true", |f| f.starts_with("yade/")),
+        ("vtu: true", |f| f == "specimen.vtu"),
+        ("report: true", |f| {
+            f == "report.md" || f.starts_with("plots/")
+        }),
+    ];
+    let base_poses = std::fs::read_to_string(base_dir.join("poses.csv")).expect("poses");
+    for (k, (flag, own)) in cases.iter().enumerate() {
+        let d = dir.join(format!("flag-{k}"));
+        run(&scene_text(&config, &d, AUTO, flag)).unwrap_or_else(|e| panic!("{flag}: {e:#}"));
+        let files = files_under(&d);
+        let added: BTreeSet<&String> = files.difference(&base_files).collect();
+        let removed: Vec<&String> = base_files.difference(&files).collect();
+        assert!(removed.is_empty(), "{flag} removed {removed:?}");
+        assert!(!added.is_empty(), "{flag} added nothing");
+        for f in &added {
+            assert!(own(f), "{flag} wrote {f}, not its own file");
+        }
+        // the placement does not depend on the outputs
+        let poses = std::fs::read_to_string(d.join("poses.csv")).expect("poses");
+        assert_eq!(poses, base_poses, "{flag} changed poses.csv");
+    }
+    // specific contents
+    let lsdem = files_under(&dir.join("flag-0"));
+    assert_eq!(
+        lsdem
+            .iter()
+            .filter(|f| f.starts_with("lsdem/grain-"))
+            .count(),
+        20,
+        "one morph file per grain"
+    );
+    // one grid unit for every morph file; positions in that unit
+    let poses = std::fs::read_to_string(dir.join("flag-0/lsdem/poses.txt")).expect("poses");
+    let spacings: BTreeSet<String> = poses
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .filter_map(|l| l.split_whitespace().last().map(String::from))
+        .collect();
+    assert_eq!(spacings.len(), 1, "{spacings:?}");
+    let positions =
+        std::fs::read_to_string(dir.join("flag-0/lsdem/positions.dat")).expect("positions");
+    assert_eq!(positions.lines().count(), 20);
+    let morph = levelset::io::read_morph(std::io::BufReader::new(
+        std::fs::File::open(dir.join("flag-0/lsdem/grain-000000.dat")).expect("morph"),
+    ))
+    .expect("the morph file reads back");
+    assert!(morph.mass > 0.0 && morph.points.len() == 1000);
+    let body = std::fs::read_to_string(dir.join("flag-1/lammps/clumps.body")).expect("body");
+    let data = packer_quadtree::read_lammps_data3(std::io::BufReader::new(
+        std::fs::File::open(dir.join("flag-1/lammps/clumps.data")).expect("data"),
+    ))
+    .expect("the data file reads back");
+    let n_body: usize = body
+        .lines()
+        .find(|l| !l.starts_with('#'))
+        .and_then(|l| l.trim().parse().ok())
+        .expect("count line");
+    assert_eq!(n_body, data.spheres.len());
+    let vtu = std::fs::read_to_string(dir.join("flag-4/specimen.vtu")).expect("vtu");
+    assert!(vtu.contains("grain_id") && vtu.trim_end().ends_with("</VTKFile>"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_clumps_only_scene_skips_the_level_set_outputs() {
+    let dir = tmp("clumps");
+    let config = cheap_config(&dir);
+    let out = dir.join("out");
+    let r = run(&scene_text(
+        &config,
+        &out,
+        AUTO,
+        "lammps_clumps: true, clump: (spheres_per_clump: 10)",
+    ))
+    .expect("clumps scene");
+    let lsdem = r.stage("lsdem").expect("lsdem stage listed");
+    assert!(lsdem.skipped.is_some(), "{lsdem:?}");
+    assert!(lsdem.seconds == 0.0, "{lsdem:?}");
+    for s in ["report", "vtu", "liggghts", "yade"] {
+        let st = r.stage(s).expect("listed");
+        assert!(st.skipped.is_some() && st.seconds == 0.0, "{st:?}");
+    }
+    assert!(r.stage("level sets").expect("listed").skipped.is_none());
+    assert!(r.stage("clumps").expect("listed").skipped.is_none());
+    let files = files_under(&out);
+    assert!(
+        files
+            .iter()
+            .all(|f| !f.ends_with(".dat") && !f.ends_with(".vtk") && !f.ends_with(".vtu")),
+        "{files:?}"
+    );
+    let text = std::fs::read_to_string(out.join("report.txt")).expect("report");
+    assert!(
+        text.contains("lsdem") && text.contains("skipped (no LS-DEM asked)"),
+        "{text}"
+    );
+    // a rerun into the same out_dir replaces its output folders (no stale files)
+    std::fs::write(out.join("lammps/stale.data"), "old").expect("plant a stale file");
+    run(&scene_text(
+        &config,
+        &out,
+        AUTO,
+        "lammps_clumps: true, clump: (spheres_per_clump: 10)",
+    ))
+    .expect("rerun");
+    assert!(!out.join("lammps/stale.data").exists());
+    assert!(out.join("lammps/clumps.data").exists());
+    // nothing is rasterised when no output needs it
+    let none = run(&scene_text(&config, &dir.join("none"), AUTO, "")).expect("no outputs");
+    assert!(none.stage("level sets").expect("listed").skipped.is_some());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Runs a bad scene: returns the error text and checks that `out_dir`
+/// (and no staging folder) exists afterwards.
+fn bad(dir: &Path, text: &str) -> String {
+    let e = match run(text) {
+        Ok(_) => panic!("expected an error:\n{text}"),
+        Err(e) => format!("{e:#}"),
+    };
+    assert!(!dir.join("out").exists(), "out_dir left after: {e}");
+    let leftovers: Vec<_> = std::fs::read_dir(dir)
+        .expect("dir")
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().contains("staging"))
+        .collect();
+    assert!(leftovers.is_empty(), "staging left after: {e}");
+    e
+}
+
+#[test]
+fn bad_scenes_name_the_key_or_file_and_write_nothing() {
+    let dir = tmp("bad");
+    let config = cheap_config(&dir);
+    let out = dir.join("out");
+    // unknown key, at top level and inside outputs
+    let e = bad(
+        &dir,
+        &scene_text(&config, &out, AUTO, "").replace("seed:", "sead:"),
+    );
+    assert!(e.contains("sead") && e.contains("test.ron:"), "{e}");
+    let e = bad(&dir, &scene_text(&config, &out, AUTO, "lsdm: true"));
+    assert!(e.contains("lsdm"), "{e}");
+    let e = bad(
+        &dir,
+        &scene_text(&config, &out, "Cylinder(diameter: 5.0, hieght: 3.0)", ""),
+    );
+    assert!(e.contains("hieght"), "{e}");
+    // count 0
+    let e = bad(
+        &dir,
+        &scene_text(&config, &out, AUTO, "").replace("Count(20)", "Count(0)"),
+    );
+    assert!(e.contains("`clones`") && e.contains("at least 1"), "{e}");
+    // missing files: calibrated configuration and parents
+    let missing = dir.join("no-such-config.ron");
+    let e = bad(&dir, &scene_text(&missing, &out, AUTO, ""));
+    assert!(
+        e.contains("`calibrated`") && e.contains("no-such-config.ron"),
+        "{e}"
+    );
+    let text = scene_text(&config, &out, AUTO, "").replace(
+        "Scene(",
+        "Scene(\n    parents: Files(path: \"/no/such/grains\"),",
+    );
+    let e = bad(&dir, &text);
+    assert!(
+        e.contains("`parents.path`") && e.contains("/no/such/grains"),
+        "{e}"
+    );
+    // a container too small for the largest clone (Ottawa clones: bounding diameters ≈ 300-650)
+    let e = bad(
+        &dir,
+        &scene_text(&config, &out, "Cylinder(diameter: 5.0)", "lsdem: true"),
+    );
+    assert!(
+        e.contains("`container` is too small for the largest clone"),
+        "{e}"
+    );
+    // a container that cannot take every clone
+    let e = bad(
+        &dir,
+        &scene_text(
+            &config,
+            &out,
+            "Box(x: 700.0, y: 700.0, z: 700.0)",
+            "vtu: true",
+        ),
+    );
+    assert!(e.contains("cannot take all 20 clones"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_example_scenes_parse() {
+    for name in ["specimen-clumps.ron", "specimen-lsdem.ron"] {
+        let p = root().join("examples").join(name);
+        let s = Scene::read(&p).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        assert!(s.clones.count() >= 1);
+    }
+}
+
+/// Non-overlap by construction needs every grain inside its bounding
+/// sphere: the rasterised surface (interpolated between mesh nodes) stays
+/// within `BOUNDING_MARGIN` × the largest node radius.
+#[test]
+fn grains_stay_inside_their_bounding_spheres() {
+    let dir = tmp("bounding");
+    let config = cheap_config(&dir);
+    let text = std::fs::read_to_string(config).expect("config");
+    let cal = cloner::Calibrated::from_ron(&text).expect("parses");
+    let parents = super::ottawa().expect("parents");
+    let mut params = cal.params;
+    params.outputs = cloner::Outputs {
+        level_set: false,
+        dna: false,
+    };
+    let model = cloner::CloneModel::fit(parents, &params).expect("fit");
+    let run = model.run(0..20, cloner::Hooks::default()).expect("run");
+    let mut worst = 0.0_f64;
+    for c in &run.clones {
+        let g = model.rasterise_at(&c.radii, 31).expect("grid");
+        let far = g
+            .marching_cubes()
+            .vertices()
+            .iter()
+            .map(|p| p.coords.norm())
+            .fold(0.0, f64::max);
+        worst = worst.max(far / c.surface.r_max);
+    }
+    assert!(
+        worst <= super::place::BOUNDING_MARGIN,
+        "a surface reaches {worst:.4} × the largest node radius"
+    );
+    println!("farthest surface point / largest node radius: {worst:.4}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
