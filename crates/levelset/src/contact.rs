@@ -63,24 +63,10 @@ impl Grid {
                 first = i;
             }
         }
-        let mut mind = vec![f64::INFINITY; cand.len()];
-        let mut out = Vec::with_capacity(count);
-        let mut next = first;
-        for _ in 0..count {
-            let s = cand[next];
-            out.push(s);
-            let mut best = (-1.0, 0usize);
-            for (i, p) in cand.iter().enumerate() {
-                let d = (p - s).norm_squared();
-                if d < mind[i] {
-                    mind[i] = d;
-                }
-                if mind[i] > best.0 {
-                    best = (mind[i], i);
-                }
-            }
-            next = best.1;
-        }
+        let mut out: Vec<Point3<f64>> = farthest_points(&cand, first, count)
+            .into_iter()
+            .map(|i| cand[i])
+            .collect();
         for p in &mut out {
             if let Ok(q) = self.closest_point(p)
                 && (q - *p).norm() < self.spacing()
@@ -90,6 +76,109 @@ impl Grid {
         }
         Ok(out)
     }
+}
+
+/// Greedy farthest-point selection of `count` of `cand`, starting at `first`: each pick
+/// is the candidate farthest from those picked (ties: lowest index). Returns indices.
+///
+/// The candidates are binned in cells (about 16 per cell); a cell whose box is no
+/// closer to the new pick than its largest distance-to-the-picked cannot change and is
+/// skipped, and the argmax is taken over the cells' maxima. The distances and the tie
+/// rule are those of the plain O(count · n) scan ([`farthest_points_plain`]), so the
+/// selection is identical; late picks touch only the few cells near them.
+fn farthest_points(cand: &[Point3<f64>], first: usize, count: usize) -> Vec<usize> {
+    let n = cand.len();
+    let (mut lo, mut hi) = (cand[0].coords, cand[0].coords);
+    for p in cand {
+        lo = lo.inf(&p.coords);
+        hi = hi.sup(&p.coords);
+    }
+    let cells_per_axis = ((n as f64 / 16.0).cbrt().ceil() as usize).clamp(1, 64);
+    let ext = (hi - lo).map(|e| e.max(f64::MIN_POSITIVE));
+    let cell_of = |p: &Point3<f64>| -> usize {
+        let mut c = 0;
+        for k in (0..3).rev() {
+            let t = ((p[k] - lo[k]) / ext[k] * cells_per_axis as f64) as usize;
+            c = c * cells_per_axis + t.min(cells_per_axis - 1);
+        }
+        c
+    };
+    let n_cells = cells_per_axis.pow(3);
+    // members of each cell in index order, and each cell's exact bounding box
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); n_cells];
+    for (i, p) in cand.iter().enumerate() {
+        members[cell_of(p)].push(i);
+    }
+    members.retain(|m| !m.is_empty());
+    let boxes: Vec<(Vector3<f64>, Vector3<f64>)> = members
+        .iter()
+        .map(|m| {
+            m.iter()
+                .fold((cand[m[0]].coords, cand[m[0]].coords), |(a, b), &i| {
+                    (a.inf(&cand[i].coords), b.sup(&cand[i].coords))
+                })
+        })
+        .collect();
+    let mut mind = vec![f64::INFINITY; n];
+    // per cell: (largest mind, its lowest index)
+    let mut best: Vec<(f64, usize)> = members.iter().map(|m| (f64::INFINITY, m[0])).collect();
+    let mut out = Vec::with_capacity(count);
+    let mut next = first;
+    for _ in 0..count {
+        let s = cand[next];
+        out.push(next);
+        for (c, m) in members.iter().enumerate() {
+            let (a, b) = &boxes[c];
+            let gap = (a - s.coords).sup(&(s.coords - b)).sup(&Vector3::zeros());
+            // conservative: skip only when every member is certainly no closer
+            if gap.norm_squared() * (1.0 - 1e-9) > best[c].0 {
+                continue;
+            }
+            let mut cb = (-1.0, m[0]);
+            for &i in m {
+                let d = (cand[i] - s).norm_squared();
+                if d < mind[i] {
+                    mind[i] = d;
+                }
+                if mind[i] > cb.0 {
+                    cb = (mind[i], i);
+                }
+            }
+            best[c] = cb;
+        }
+        let mut g = (-1.0, 0usize);
+        for &(v, i) in &best {
+            if v > g.0 || (v == g.0 && i < g.1) {
+                g = (v, i);
+            }
+        }
+        next = g.1;
+    }
+    out
+}
+
+/// The plain O(count · n) farthest-point scan: the oracle of [`farthest_points`].
+#[cfg(test)]
+fn farthest_points_plain(cand: &[Point3<f64>], first: usize, count: usize) -> Vec<usize> {
+    let mut mind = vec![f64::INFINITY; cand.len()];
+    let mut out = Vec::with_capacity(count);
+    let mut next = first;
+    for _ in 0..count {
+        let s = cand[next];
+        out.push(next);
+        let mut best = (-1.0, 0usize);
+        for (i, p) in cand.iter().enumerate() {
+            let d = (p - s).norm_squared();
+            if d < mind[i] {
+                mind[i] = d;
+            }
+            if mind[i] > best.0 {
+                best = (mind[i], i);
+            }
+        }
+        next = best.1;
+    }
+    out
 }
 
 /// A grain for contact: level set and surface nodes in the body frame, plus a bounding
@@ -237,6 +326,32 @@ mod tests {
     use super::*;
     use crate::grid::GridSpec;
     use crate::shapes::Sphere;
+
+    /// The binned farthest-point selection picks exactly what the plain scan picks: on
+    /// marching-cubes vertices and on a lattice (many exact ties).
+    #[test]
+    fn binned_farthest_points_equal_the_plain_scan() {
+        let spec = GridSpec::cube(31, -1.2, 1.2).expect("spec");
+        let g = Grid::from_shape(spec, &Sphere::new(1.0).expect("s"), &Isometry3::identity())
+            .expect("grid");
+        let verts = g.marching_cubes().vertices().to_vec();
+        let mut lattice = Vec::new();
+        for i in 0..12 {
+            for j in 0..9 {
+                for k in 0..7 {
+                    lattice.push(Point3::new(i as f64, 0.5 * j as f64, 2.0 * k as f64));
+                }
+            }
+        }
+        for (cand, count) in [(&verts, 400), (&verts, 7), (&lattice, 300), (&lattice, 756)] {
+            for first in [0, cand.len() / 3] {
+                assert_eq!(
+                    farthest_points(cand, first, count),
+                    farthest_points_plain(cand, first, count)
+                );
+            }
+        }
+    }
 
     fn sphere_body(nodes: usize) -> Body {
         let spec = GridSpec::cube(45, -1.2, 1.2).expect("spec");

@@ -436,7 +436,9 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                     let t3 = Instant::now();
                     ns[2].fetch_add((t3 - t2).as_nanos() as u64, Ordering::Relaxed);
                     if out.vtu {
-                        g.mesh = Some(grid.marching_cubes());
+                        let coarse = coarsen(&grid, out.vtu_resolution)
+                            .with_context(|| format!("VTU grid of clone {}", c.index))?;
+                        g.mesh = Some(coarse.as_ref().unwrap_or(&grid).marching_cubes());
                     }
                     ns[3].fetch_add(t3.elapsed().as_nanos() as u64, Ordering::Relaxed);
                     Ok(g)
@@ -509,6 +511,10 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 outputs::lsdem_positions(&lsdem_poses).as_bytes(),
             )?;
             staging.write(
+                "lsdem/rotations.dat",
+                outputs::lsdem_rotations(&lsdem_poses).as_bytes(),
+            )?;
+            staging.write(
                 "lsdem/morphID.dat",
                 outputs::lsdem_morph_ids(&lsdem_poses).as_bytes(),
             )?;
@@ -516,7 +522,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 "lsdem",
                 cpu(1) + t.elapsed().as_secs_f64(),
                 format!(
-                    "{} morph files ({} surface nodes, one grid unit = {:.4}) + poses.txt, positions.dat, morphID.dat (CPU)",
+                    "{} morph files ({} surface nodes, one grid unit = {:.4}) + poses.txt, positions.dat, rotations.dat, morphID.dat (CPU)",
                     lsdem_poses.len(),
                     out.lsdem_nodes,
                     lsdem_poses.first().map_or(f64::NAN, |p| p.spacing)
@@ -592,8 +598,9 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             "vtu",
             cpu(3),
             format!(
-                "specimen.vtu: {triangles} marching-cubes triangles of {} grains, grain_id per cell (CPU)",
-                run.clones.len()
+                "specimen.vtu: {triangles} marching-cubes triangles of {} grains at {} cells across, binary, grain_id per cell (CPU)",
+                run.clones.len(),
+                out.vtu_resolution.min(scene.level_set_resolution - 1)
             ),
         ),
     }
@@ -684,6 +691,25 @@ fn resample(grid: &levelset::Grid, h: f64) -> anyhow::Result<levelset::Grid> {
         spacing: h,
     };
     Ok(levelset::Grid::from_fn(spec, |p| grid.value(p))?)
+}
+
+/// `grid` resampled (trilinear) over the same box at `cells` cells across
+/// its largest side, for the VTU surface only; `None` when the grid is
+/// already that coarse (no upsampling).
+fn coarsen(grid: &levelset::Grid, cells: usize) -> anyhow::Result<Option<levelset::Grid>> {
+    let d = grid.dims();
+    let widest = d[0].max(d[1]).max(d[2]) - 1;
+    if cells >= widest {
+        return Ok(None);
+    }
+    let h = widest as f64 * grid.spacing() / cells as f64;
+    let n = |k: usize| ((((d[k] - 1) as f64 * grid.spacing()) / h).round() as usize + 1).max(2);
+    let spec = levelset::GridSpec {
+        dims: [n(0), n(1), n(2)],
+        origin: grid.origin(),
+        spacing: h,
+    };
+    Ok(Some(levelset::Grid::from_fn(spec, |p| grid.value(p))?))
 }
 
 /// The per-grain products of the level-set stage.

@@ -131,7 +131,8 @@ pub(crate) fn lsdem_poses(poses: &[LsdemPose]) -> String {
          # q0 q1 q2 q3: unit quaternion (scalar first) rotating the morph file's axes to the world;\n\
          # spacing: world length of one grid unit (the same for every morph file: they use spacing 1),\n\
          # so a morph point p (relative to the centre of mass, grid units) is at x + R(q) * spacing * p.\n\
-         # positions.dat holds x y z / spacing (grid units), one grain per line, morphID.dat the file numbers.\n",
+         # positions.dat holds x y z / spacing (grid units), one grain per line, morphID.dat the file numbers,\n\
+         # rotations.dat the same rotations in LS-DEM's own quaternion convention (q0 q1 q2 q3 = y -x -z w).\n",
     );
     for p in poses {
         let q = p.pose.rotation.quaternion();
@@ -152,6 +153,55 @@ pub(crate) fn lsdem_positions(poses: &[LsdemPose]) -> String {
     for p in poses {
         let c = p.centre.coords / p.spacing;
         let _ = writeln!(s, "{:e} {:e} {:e}", c.x, c.y, c.z);
+    }
+    s
+}
+
+/// The LS-DEM quaternion `[q0, q1, q2, q3]` of a body → world rotation.
+///
+/// LS-DEM (Kawamoto et al. 2016, 2018; `Grain3d::updateRotationMatrix` of
+/// the Kawamoto/Andrade code and its descendants) stores `(X, Y, Z, W)` but
+/// builds its rotation matrix with a sign and axis convention of its own:
+/// for a Hamilton unit quaternion `w + x i + y j + z k` whose matrix is the
+/// body → world rotation `R` (world point = `R · morph point + position`,
+/// the convention of its `_pointList = _rotMatrix * _refPointList +
+/// _position`), LS-DEM's matrix equals `R` when the file holds
+/// `q0 = y, q1 = −x, q2 = −z, q3 = w`. [`lsdem_matrix`] is that matrix,
+/// written out as LS-DEM does; the tests check the round trip.
+pub(crate) fn lsdem_quaternion(rotation: &nalgebra::UnitQuaternion<f64>) -> [f64; 4] {
+    let q = rotation.quaternion();
+    // one sign for q and −q (the same rotation): W ≥ 0
+    let s = if q.w < 0.0 { -1.0 } else { 1.0 };
+    [s * q.j, -s * q.i, -s * q.k, s * q.w]
+}
+
+/// LS-DEM's rotation matrix of a file quaternion `[q0, q1, q2, q3]`
+/// (`Grain3d::updateRotationMatrix`, term by term): the body → world
+/// rotation the simulation will apply.
+#[cfg(test)]
+pub(crate) fn lsdem_matrix(q: [f64; 4]) -> nalgebra::Matrix3<f64> {
+    let [a, b, c, d] = q;
+    nalgebra::Matrix3::new(
+        -a * a + b * b - c * c + d * d,
+        -2.0 * (a * b - c * d),
+        2.0 * (b * c + a * d),
+        -2.0 * (a * b + c * d),
+        a * a - b * b - c * c + d * d,
+        -2.0 * (a * c - b * d),
+        2.0 * (b * c - a * d),
+        -2.0 * (a * c + b * d),
+        -a * a - b * b + c * c + d * d,
+    )
+}
+
+/// `lsdem/rotations.dat`: one LS-DEM quaternion `q0 q1 q2 q3` per line of
+/// `positions.dat` (single spaces, no header: LS-DEM's
+/// `readQuaternionFile`), see [`lsdem_quaternion`] for the convention.
+pub(crate) fn lsdem_rotations(poses: &[LsdemPose]) -> String {
+    let mut s = String::new();
+    for p in poses {
+        let [a, b, c, d] = lsdem_quaternion(&p.pose.rotation);
+        let _ = writeln!(s, "{a:e} {b:e} {c:e} {d:e}");
     }
     s
 }
@@ -285,12 +335,26 @@ pub(crate) fn liggghts_templates(
     (files, script)
 }
 
-/// A streaming VTU (UnstructuredGrid, ASCII) of grain surfaces: one
-/// `<Piece>` per call of [`VtuWriter::piece`], triangles with a `grain_id`
-/// cell field.
+/// A streaming VTU (UnstructuredGrid, VTK XML with inline binary data) of
+/// grain surfaces: one `<Piece>` per call of [`VtuWriter::piece`],
+/// triangles with a `grain_id` cell field.
+///
+/// Every `DataArray` is `format="binary"` with `compressor=
+/// "vtkZLibDataCompressor"` and `header_type="UInt64"` (VTK file formats,
+/// "XML File Formats", binary data): the UInt64 header `[blocks,
+/// block size, last partial block size (0 when full), compressed size of
+/// each block]` base64-encoded on its own, then the zlib blocks
+/// base64-encoded as one stream — what `vtkXMLWriter` writes. Points are
+/// Float32 (a relative precision of 6·10⁻⁸ is far below a surface cell),
+/// connectivity and offsets Int32 (piece-local), types UInt8, `grain_id`
+/// Int32. ParaView and VTK ≥ 6 read it.
 pub(crate) struct VtuWriter<W: Write> {
     w: W,
 }
+
+/// Uncompressed bytes per zlib block of a VTU array (VTK's default 32 KiB
+/// is too small to compress the long regular arrays well).
+const VTU_BLOCK: usize = 1 << 20;
 
 /// Triangles of several grains in the world frame, with their grain ids.
 #[derive(Default)]
@@ -312,64 +376,153 @@ impl Surfaces {
     }
 }
 
+/// Base64 (RFC 4648, with padding) of `bytes`, appended to `out`.
+pub(crate) fn base64_into(bytes: &[u8], out: &mut String) {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    out.reserve(bytes.len().div_ceil(3) * 4);
+    for c in bytes.chunks(3) {
+        let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= c.len() {
+                out.push(char::from(ALPHABET[(n >> (18 - 6 * k)) as usize & 63]));
+            } else {
+                out.push('=');
+            }
+        }
+    }
+}
+
+/// Decodes base64 (the inverse of [`base64_into`]); `None` on a bad byte.
+#[cfg(test)]
+pub(crate) fn base64_decode(text: &str) -> Option<Vec<u8>> {
+    let val = |c: u8| -> Option<u32> {
+        Some(match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => return None,
+        } as u32)
+    };
+    let t: Vec<u8> = text.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
+    let mut out = Vec::with_capacity(t.len() / 4 * 3);
+    for q in t.chunks(4) {
+        let pad = q.iter().filter(|c| **c == b'=').count();
+        let mut n = 0u32;
+        for (k, c) in q.iter().enumerate() {
+            n |= if *c == b'=' { 0 } else { val(*c)? } << (18 - 6 * k);
+        }
+        let b = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
+        out.extend_from_slice(&b[..3 - pad]);
+    }
+    Some(out)
+}
+
 impl<W: Write> VtuWriter<W> {
     pub(crate) fn new(mut w: W) -> std::io::Result<Self> {
         writeln!(w, r#"<?xml version="1.0"?>"#)?;
         writeln!(
             w,
-            r#"<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian">"#
+            r#"<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64" compressor="vtkZLibDataCompressor">"#
         )?;
         writeln!(w, "<UnstructuredGrid>")?;
         Ok(Self { w })
     }
 
-    pub(crate) fn piece(&mut self, s: &Surfaces) -> std::io::Result<()> {
-        let w = &mut self.w;
+    /// One binary `DataArray`: zlib blocks of [`VTU_BLOCK`] bytes behind
+    /// the UInt64 compression header, each base64-encoded.
+    fn array(
+        &mut self,
+        kind: &str,
+        name: &str,
+        components: usize,
+        data: &[u8],
+    ) -> std::io::Result<()> {
+        let name = if name.is_empty() {
+            String::new()
+        } else {
+            format!(r#" Name="{name}""#)
+        };
+        let blocks: Vec<Vec<u8>> = data
+            .chunks(VTU_BLOCK)
+            .map(|b| {
+                let mut z = flate2::write::ZlibEncoder::new(
+                    Vec::with_capacity(b.len() / 2),
+                    flate2::Compression::fast(),
+                );
+                z.write_all(b)?;
+                z.finish()
+            })
+            .collect::<std::io::Result<_>>()?;
+        let mut header: Vec<u64> = vec![
+            blocks.len() as u64,
+            VTU_BLOCK as u64,
+            (data.len() % VTU_BLOCK) as u64,
+        ];
+        header.extend(blocks.iter().map(|b| b.len() as u64));
+        let header: Vec<u8> = header.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let mut text = String::new();
+        base64_into(&header, &mut text);
+        base64_into(&blocks.concat(), &mut text);
         writeln!(
-            w,
+            self.w,
+            r#"<DataArray type="{kind}"{name} NumberOfComponents="{components}" format="binary">"#
+        )?;
+        self.w.write_all(text.as_bytes())?;
+        writeln!(self.w, "\n</DataArray>")
+    }
+
+    pub(crate) fn piece(&mut self, s: &Surfaces) -> std::io::Result<()> {
+        let too_big = |what: &str| {
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("a VTU piece has more {what} than Int32 indexes"),
+            )
+        };
+        if s.points.len() > i32::MAX as usize {
+            return Err(too_big("points"));
+        }
+        if 3 * s.triangles.len() > i32::MAX as usize {
+            return Err(too_big("triangles"));
+        }
+        writeln!(
+            self.w,
             r#"<Piece NumberOfPoints="{}" NumberOfCells="{}">"#,
             s.points.len(),
             s.triangles.len()
         )?;
-        writeln!(w, "<Points>")?;
-        writeln!(
-            w,
-            r#"<DataArray type="Float64" NumberOfComponents="3" format="ascii">"#
-        )?;
+        writeln!(self.w, "<Points>")?;
+        let mut b = Vec::with_capacity(12 * s.points.len());
         for p in &s.points {
-            writeln!(w, "{:.7e} {:.7e} {:.7e}", p.x, p.y, p.z)?;
+            for v in [p.x, p.y, p.z] {
+                b.extend_from_slice(&(v as f32).to_le_bytes());
+            }
         }
-        writeln!(w, "</DataArray>\n</Points>\n<Cells>")?;
-        writeln!(
-            w,
-            r#"<DataArray type="Int64" Name="connectivity" format="ascii">"#
-        )?;
+        self.array("Float32", "", 3, &b)?;
+        writeln!(self.w, "</Points>\n<Cells>")?;
+        b.clear();
         for t in &s.triangles {
-            writeln!(w, "{} {} {}", t[0], t[1], t[2])?;
+            for v in t {
+                b.extend_from_slice(&(*v as i32).to_le_bytes());
+            }
         }
-        writeln!(w, "</DataArray>")?;
-        writeln!(
-            w,
-            r#"<DataArray type="Int64" Name="offsets" format="ascii">"#
-        )?;
+        self.array("Int32", "connectivity", 1, &b)?;
+        b.clear();
         for k in 0..s.triangles.len() {
-            writeln!(w, "{}", 3 * (k + 1))?;
+            b.extend_from_slice(&(3 * (k as i32 + 1)).to_le_bytes());
         }
-        writeln!(w, "</DataArray>")?;
-        writeln!(w, r#"<DataArray type="UInt8" Name="types" format="ascii">"#)?;
-        for _ in &s.triangles {
-            writeln!(w, "5")?;
-        }
-        writeln!(w, "</DataArray>\n</Cells>")?;
-        writeln!(w, r#"<CellData Scalars="grain_id">"#)?;
-        writeln!(
-            w,
-            r#"<DataArray type="Int64" Name="grain_id" format="ascii">"#
-        )?;
+        self.array("Int32", "offsets", 1, &b)?;
+        self.array("UInt8", "types", 1, &vec![5u8; s.triangles.len()])?;
+        writeln!(self.w, "</Cells>")?;
+        writeln!(self.w, r#"<CellData Scalars="grain_id">"#)?;
+        b.clear();
         for id in &s.grain_ids {
-            writeln!(w, "{id}")?;
+            b.extend_from_slice(&(*id as i32).to_le_bytes());
         }
-        writeln!(w, "</DataArray>\n</CellData>\n</Piece>")?;
+        self.array("Int32", "grain_id", 1, &b)?;
+        writeln!(self.w, "</CellData>\n</Piece>")?;
         Ok(())
     }
 
@@ -377,6 +530,119 @@ impl<W: Write> VtuWriter<W> {
         writeln!(self.w, "</UnstructuredGrid>\n</VTKFile>")?;
         Ok(self.w)
     }
+}
+
+/// A VTU of [`VtuWriter`] read back: per piece, the point, triangle and
+/// grain-id arrays (tests only).
+#[cfg(test)]
+pub(crate) struct VtuPiece {
+    pub(crate) points: Vec<[f32; 3]>,
+    pub(crate) connectivity: Vec<i32>,
+    pub(crate) offsets: Vec<i32>,
+    pub(crate) types: Vec<u8>,
+    pub(crate) grain_ids: Vec<i32>,
+}
+
+/// Reads back a VTU written by [`VtuWriter`] (tests only): checks the
+/// header counts of every array and the piece's declared sizes.
+#[cfg(test)]
+pub(crate) fn read_vtu(text: &str) -> anyhow::Result<Vec<VtuPiece>> {
+    use anyhow::{bail, ensure};
+    // the header (its own base64 stream: 3 + blocks UInt64), then the blocks
+    let decode = |body: &str| -> anyhow::Result<Vec<u8>> {
+        use std::io::Read as _;
+        let body = body.trim();
+        let first = base64_decode(body.get(..16).unwrap_or(""))
+            .ok_or_else(|| anyhow::anyhow!("bad base64"))?;
+        ensure!(first.len() >= 8, "no header");
+        let blocks = u64::from_le_bytes(first[..8].try_into()?) as usize;
+        let header_chars = (8 * (3 + blocks)).div_ceil(3) * 4;
+        ensure!(body.len() >= header_chars, "truncated header");
+        let header = base64_decode(&body[..header_chars])
+            .ok_or_else(|| anyhow::anyhow!("bad base64 header"))?;
+        let h: Vec<usize> = header
+            .chunks_exact(8)
+            .map(|x| u64::from_le_bytes(x.try_into().unwrap_or([0; 8])) as usize)
+            .collect();
+        ensure!(h.len() == 3 + blocks, "header of {} values", h.len());
+        let z = base64_decode(&body[header_chars..])
+            .ok_or_else(|| anyhow::anyhow!("bad base64 data"))?;
+        ensure!(
+            z.len() == h[3..].iter().sum::<usize>(),
+            "compressed sizes disagree"
+        );
+        let mut out = Vec::new();
+        let mut at = 0;
+        for (k, c) in h[3..].iter().enumerate() {
+            let mut block = Vec::new();
+            flate2::read::ZlibDecoder::new(&z[at..at + c]).read_to_end(&mut block)?;
+            let want = if k + 1 == blocks && h[2] > 0 {
+                h[2]
+            } else {
+                h[1]
+            };
+            ensure!(
+                block.len() == want,
+                "block {k}: {} bytes, not {want}",
+                block.len()
+            );
+            out.extend_from_slice(&block);
+            at += c;
+        }
+        Ok(out)
+    };
+    let attr = |tag: &str, key: &str| -> anyhow::Result<usize> {
+        let k = format!("{key}=\"");
+        let at = tag.find(&k).ok_or_else(|| anyhow::anyhow!("no {key}"))? + k.len();
+        let end = tag[at..]
+            .find('"')
+            .ok_or_else(|| anyhow::anyhow!("bad {key}"))?;
+        Ok(tag[at..at + end].parse()?)
+    };
+    let mut pieces = Vec::new();
+    for chunk in text.split("<Piece ").skip(1) {
+        let head = &chunk[..chunk.find('>').unwrap_or(0)];
+        let (np, nc) = (attr(head, "NumberOfPoints")?, attr(head, "NumberOfCells")?);
+        let mut arrays = Vec::new();
+        for a in chunk.split("<DataArray ").skip(1) {
+            let open = a
+                .find('>')
+                .ok_or_else(|| anyhow::anyhow!("bad DataArray"))?;
+            let close = a
+                .find("</DataArray>")
+                .ok_or_else(|| anyhow::anyhow!("unclosed"))?;
+            ensure!(a[..open].contains(r#"format="binary""#), "not binary");
+            arrays.push(decode(&a[open + 1..close])?);
+        }
+        let [p, c, o, t, g] = <[Vec<u8>; 5]>::try_from(arrays)
+            .map_err(|a| anyhow::anyhow!("{} arrays in a piece, not 5", a.len()))?;
+        let i32s = |b: &[u8]| -> Vec<i32> {
+            b.chunks_exact(4)
+                .map(|x| i32::from_le_bytes([x[0], x[1], x[2], x[3]]))
+                .collect()
+        };
+        let f: Vec<f32> = p
+            .chunks_exact(4)
+            .map(|x| f32::from_le_bytes([x[0], x[1], x[2], x[3]]))
+            .collect();
+        let piece = VtuPiece {
+            points: f.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect(),
+            connectivity: i32s(&c),
+            offsets: i32s(&o),
+            types: t,
+            grain_ids: i32s(&g),
+        };
+        if piece.points.len() != np
+            || piece.offsets.len() != nc
+            || piece.types.len() != nc
+            || piece.grain_ids.len() != nc
+            || piece.connectivity.len() != 3 * nc
+        {
+            bail!("a piece's arrays disagree with NumberOfPoints={np} NumberOfCells={nc}");
+        }
+        pieces.push(piece);
+    }
+    Ok(pieces)
 }
 
 /// `poses.csv`: every placed grain's pose (always written).

@@ -161,6 +161,9 @@ fn each_output_flag_changes_only_its_own_files() {
     assert_eq!(n_body, data.spheres.len());
     let vtu = std::fs::read_to_string(dir.join("flag-4/specimen.vtu")).expect("vtu");
     assert!(vtu.contains("grain_id") && vtu.trim_end().ends_with("</VTKFile>"));
+    assert!(vtu.contains(r#"header_type="UInt64""#) && !vtu.contains(r#"format="ascii""#));
+    vtu_reads_back(&vtu, 20);
+    lsdem_rotations_round_trip(&dir.join("flag-0"), &base_poses);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -337,4 +340,141 @@ fn grains_stay_inside_their_bounding_spheres() {
     );
     println!("farthest surface point / largest node radius: {worst:.4}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The binary VTU read back: every array's byte count matches its piece's
+/// counts, triangles index their own piece, every grain has a surface.
+fn vtu_reads_back(vtu: &str, grains: usize) {
+    let pieces = super::outputs::read_vtu(vtu).expect("the VTU reads back");
+    assert!(!pieces.is_empty());
+    let mut ids = BTreeSet::new();
+    for p in &pieces {
+        assert!(p.types.iter().all(|t| *t == 5), "triangles only");
+        for (k, o) in p.offsets.iter().enumerate() {
+            assert_eq!(*o as usize, 3 * (k + 1));
+        }
+        assert!(
+            p.connectivity
+                .iter()
+                .all(|v| *v >= 0 && (*v as usize) < p.points.len())
+        );
+        assert!(p.points.iter().flatten().all(|v| v.is_finite()));
+        ids.extend(p.grain_ids.iter().copied());
+    }
+    assert_eq!(ids.len(), grains, "one surface per grain: {ids:?}");
+}
+
+/// `lsdem/rotations.dat`, turned into matrices as LS-DEM does, are the
+/// rotations of `poses.csv`, and `positions.dat · spacing` are the centres
+/// of mass of `poses.txt`.
+fn lsdem_rotations_round_trip(dir: &Path, poses_csv: &str) {
+    let nums = |l: &str| -> Vec<f64> {
+        l.split([' ', ','])
+            .filter_map(|x| x.parse::<f64>().ok())
+            .collect()
+    };
+    let rotations = std::fs::read_to_string(dir.join("lsdem/rotations.dat")).expect("rotations");
+    let ids = std::fs::read_to_string(dir.join("lsdem/morphID.dat")).expect("morph ids");
+    let positions = std::fs::read_to_string(dir.join("lsdem/positions.dat")).expect("positions");
+    let poses_txt = std::fs::read_to_string(dir.join("lsdem/poses.txt")).expect("poses.txt");
+    let poses: Vec<Vec<f64>> = poses_csv
+        .lines()
+        .filter(|l| l.chars().next().is_some_and(|c| c.is_ascii_digit()))
+        .map(nums)
+        .collect();
+    let txt: Vec<Vec<f64>> = poses_txt
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| nums(&l.split_whitespace().skip(2).collect::<Vec<_>>().join(" ")))
+        .collect();
+    assert_eq!(rotations.lines().count(), poses.len());
+    for (((line, id), pos), t) in rotations
+        .lines()
+        .zip(ids.lines())
+        .zip(positions.lines())
+        .zip(&txt)
+    {
+        // LS-DEM's reader: single spaces, four numbers
+        let q: Vec<f64> = line
+            .split(' ')
+            .map(|x| x.parse().expect("number"))
+            .collect();
+        let q: [f64; 4] = q.try_into().expect("four numbers per line");
+        approx::assert_relative_eq!(q.iter().map(|v| v * v).sum::<f64>(), 1.0, epsilon = 1e-12);
+        let id: usize = id.trim().parse().expect("morph id");
+        let row = poses
+            .iter()
+            .find(|r| r[0] as usize == id)
+            .expect("pose of the grain");
+        let world = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            row[4], row[5], row[6], row[7],
+        ));
+        let r = super::outputs::lsdem_matrix(q);
+        approx::assert_relative_eq!(r, *world.to_rotation_matrix().matrix(), epsilon = 1e-12);
+        // positions in grid units: × spacing = the centre of mass of poses.txt
+        let p = nums(pos);
+        let h = t[7];
+        for k in 0..3 {
+            approx::assert_relative_eq!(p[k] * h, t[k], max_relative = 1e-12);
+        }
+    }
+}
+
+#[test]
+fn lsdem_quaternions_give_lsdem_the_pose_rotation() {
+    use rand::{Rng, SeedableRng};
+    let seed = 11;
+    println!("seed {seed}");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut rotations = vec![
+        nalgebra::UnitQuaternion::identity(),
+        nalgebra::UnitQuaternion::from_euler_angles(0.3, 0.0, 0.0),
+        nalgebra::UnitQuaternion::from_euler_angles(0.0, -1.2, 0.0),
+        nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, 2.9),
+    ];
+    for _ in 0..200 {
+        let q = nalgebra::Quaternion::new(
+            rng.random::<f64>() - 0.5,
+            rng.random::<f64>() - 0.5,
+            rng.random::<f64>() - 0.5,
+            rng.random::<f64>() - 0.5,
+        );
+        rotations.push(nalgebra::UnitQuaternion::from_quaternion(q));
+    }
+    for r in rotations {
+        let q = super::outputs::lsdem_quaternion(&r);
+        assert!(q[3] >= 0.0, "W ≥ 0");
+        let m = super::outputs::lsdem_matrix(q);
+        approx::assert_relative_eq!(m, *r.to_rotation_matrix().matrix(), epsilon = 1e-12);
+        // body → world: a body point lands where the pose puts it
+        let p = nalgebra::Point3::new(0.3, -1.7, 2.2);
+        approx::assert_relative_eq!(m * p.coords, (r * p).coords, epsilon = 1e-12);
+    }
+}
+
+#[test]
+fn base64_matches_rfc_4648_and_round_trips() {
+    let enc = |b: &[u8]| {
+        let mut s = String::new();
+        super::outputs::base64_into(b, &mut s);
+        s
+    };
+    // RFC 4648 § 10 test vectors
+    for (plain, coded) in [
+        ("", ""),
+        ("f", "Zg=="),
+        ("fo", "Zm8="),
+        ("foo", "Zm9v"),
+        ("foob", "Zm9vYg=="),
+        ("fooba", "Zm9vYmE="),
+        ("foobar", "Zm9vYmFy"),
+    ] {
+        assert_eq!(enc(plain.as_bytes()), coded);
+        assert_eq!(
+            super::outputs::base64_decode(coded).expect("decodes"),
+            plain.as_bytes()
+        );
+    }
+    let bytes: Vec<u8> = (0..=255u8).cycle().take(1000).collect();
+    assert_eq!(super::outputs::base64_decode(&enc(&bytes)), Some(bytes));
 }
