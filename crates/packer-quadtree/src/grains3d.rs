@@ -195,13 +195,18 @@ pub struct GrainPackParams {
     /// Seed of the skeleton's order and of the orientations.
     pub seed: u64,
     /// Gap left between star surfaces (and to the walls), as a fraction of
-    /// the equivalent diameter of the grain tested against (default 0.005).
+    /// the equivalent diameter of the grain tested against (default 0.01:
+    /// with 0.005 the 32³ level sets of 10 000 Ottawa clones still
+    /// overlapped by φ/d = −1.5e-3 at 5 of 5.8 million nodes).
     pub margin: f64,
     /// β of the skeleton sphere diameter `(1−β)·d_eq + β·2 r_max`, in [0, 1].
     pub skeleton_blend: f64,
     /// Nodes per grain in the first relaxation stage (≥ 32).
     pub coarse_nodes: usize,
-    /// Nodes per grain in the final stage (≥ `coarse_nodes`).
+    /// Nodes per grain in the final stage (≥ `coarse_nodes`), or 0
+    /// (default) for the cube-map directions of the grains' tables: the
+    /// vertices of the tabulated surface, so a rough surface cannot reach
+    /// between nodes (1734 for 16 cells per face).
     pub fine_nodes: usize,
     /// Sweeps allowed over both stages before [`Error::NotConverged`].
     pub max_sweeps: usize,
@@ -217,10 +222,10 @@ impl Default for GrainPackParams {
     fn default() -> Self {
         Self {
             seed: 1,
-            margin: 0.005,
+            margin: 0.01,
             skeleton_blend: 0.3,
             coarse_nodes: 160,
-            fine_nodes: 600,
+            fine_nodes: 0,
             max_sweeps: 3000,
             relaxation: 1.2,
             skeleton: Pack3Params {
@@ -247,7 +252,7 @@ impl GrainPackParams {
         if self.coarse_nodes < 32 {
             return bad("coarse_nodes", self.coarse_nodes as f64, "[32, inf)");
         }
-        if self.fine_nodes < self.coarse_nodes {
+        if self.fine_nodes != 0 && self.fine_nodes < self.coarse_nodes {
             return bad("fine_nodes", self.fine_nodes as f64, "[coarse_nodes, inf)");
         }
         if self.max_sweeps == 0 {
@@ -399,7 +404,7 @@ pub fn pack_grains(
     params.validate()?;
     let total = check_input(grains, container)?;
     let fraction = total / container.volume();
-    if !(fraction <= MAX_FRACTION) {
+    if fraction.is_nan() || fraction > MAX_FRACTION {
         return Err(Error::TooDense {
             fraction,
             limit: MAX_FRACTION,

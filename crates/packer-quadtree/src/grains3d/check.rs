@@ -169,22 +169,39 @@ pub fn check_grain_overlaps(
             let mut nodes = Vec::with_capacity(dirs.len());
             let (mut resid, mut wall, mut outside) = (0.0_f64, f64::INFINITY, 0);
             for u in &dirs {
-                let mut p = u * g.radius(u);
-                let mut phi = 0.0;
+                // Radial Newton on φ(t·u) from the star radius, then
+                // bisection on the bracket [0, 1.1 r_max] if it stalls.
+                let phi_at = |t: f64| grid.sample(&(u * t).into());
+                let mut t = g.radius(u);
+                let mut phi = f64::INFINITY;
                 for _ in 0..6 {
-                    let Some((v, grad)) = grid.sample(&p.into()) else {
+                    let Some((v, grad)) = phi_at(t) else {
                         break;
                     };
                     phi = v;
-                    let gg = grad.norm_squared();
-                    if v.abs() < 1e-12 * d_eq[i] || gg == 0.0 {
+                    let slope = grad.dot(u);
+                    if v.abs() < 1e-9 * d_eq[i] || slope <= 0.1 {
                         break;
                     }
-                    p -= v * grad / gg;
+                    t = (t - v / slope).clamp(0.0, 1.1 * g.r_max());
                 }
-                if let Some((v, _)) = grid.sample(&p.into()) {
+                if let Some((v, _)) = phi_at(t) {
                     phi = v;
                 }
+                if phi.is_nan() || phi.abs() >= 1e-7 * d_eq[i] {
+                    let (mut lo, mut hi) = (0.0, 1.1 * g.r_max() * (1.0 - 1e-9));
+                    for _ in 0..40 {
+                        let mid = 0.5 * (lo + hi);
+                        match phi_at(mid) {
+                            Some((v, _)) if v < 0.0 => lo = mid,
+                            _ => hi = mid,
+                        }
+                    }
+                    // The outer end of the bracket: never inside the grain.
+                    t = hi;
+                    phi = phi_at(t).map_or(0.0, |x| x.0);
+                }
+                let p = u * t;
                 resid = resid.max(phi.abs() / d_eq[i]);
                 let cl = container.clearance(&Point3::from(rots[i] * p + cs[i])) / d_eq[i];
                 wall = wall.min(cl);

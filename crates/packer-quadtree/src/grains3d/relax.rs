@@ -22,9 +22,9 @@ struct NodeSet {
 }
 
 impl NodeSet {
-    fn new(k: usize) -> Self {
+    fn new(dirs: Vec<Vector3<f64>>) -> Self {
         let centres = fibonacci(PATCHES);
-        let mut tagged: Vec<(usize, usize, Vector3<f64>)> = fibonacci(k)
+        let mut tagged: Vec<(usize, usize, Vector3<f64>)> = dirs
             .into_iter()
             .enumerate()
             .map(|(idx, u)| {
@@ -64,9 +64,21 @@ pub(super) struct Shapes<'a> {
 }
 
 impl<'a> Shapes<'a> {
+    /// `k` Fibonacci nodes per grain, or with `k = 0` the directions of the
+    /// grains' cube map (the vertices of the tabulated surface: nothing of
+    /// a rough surface lies between them but the sagitta of a table cell).
     pub(super) fn new(grains: &'a [StarGrain], k: usize) -> Self {
-        let set = NodeSet::new(k);
-        let per: Vec<(Vec<[f32; 3]>, Vec<[f32; 4]>)> = grains
+        let dirs = if k == 0 {
+            let f = grains.iter().map(StarGrain::face_cells).max().unwrap_or(2);
+            levelset::cube_map_directions(f)
+                .map(|d| d.into_iter().map(|u| u.into_inner()).collect())
+                .unwrap_or_else(|_| fibonacci(6 * (f + 1) * (f + 1)))
+        } else {
+            fibonacci(k)
+        };
+        let set = NodeSet::new(dirs);
+        type PerGrain = (Vec<[f32; 3]>, Vec<[f32; 4]>);
+        let per: Vec<PerGrain> = grains
             .par_iter()
             .with_min_len(64)
             .map(|g| {
@@ -539,7 +551,9 @@ fn relax_at(
                     let acc = frame.pair(shapes, i, j, c, lam);
                     if acc.depth > 0.0 {
                         let mut dir = acc.dir;
-                        if !(dir.norm() > 1e-12 * acc.depth) {
+                        if dir.norm().partial_cmp(&(1e-12 * acc.depth))
+                            != Some(std::cmp::Ordering::Greater)
+                        {
                             dir = c[i] - c[j];
                         }
                         let len = dir.norm();

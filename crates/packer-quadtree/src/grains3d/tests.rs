@@ -1,6 +1,8 @@
 //! Tests of the grain packer: analytic oracles (spheres, ellipsoids), bad
 //! input, determinism for 1 and 2 threads, a small property test.
 
+#![allow(clippy::needless_range_loop)] // pairs (i, j > i) index two arrays
+
 use super::*;
 use approx::assert_relative_eq;
 use proptest::prelude::*;
@@ -68,7 +70,7 @@ fn spheres_never_overlap_by_exact_distances() {
             assert!(d >= ri + g[j].r_max(), "spheres {i} and {j} overlap: {d}");
         }
     }
-    assert!(p.stats.worst_gap_over_d >= 0.005 * (1.0 - 1e-6));
+    assert!(p.stats.worst_gap_over_d >= 0.01 * (1.0 - 1e-6));
     assert_relative_eq!(p.stats.solid_fraction, 0.5, max_relative = 1e-9);
 }
 

