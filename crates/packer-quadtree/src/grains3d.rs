@@ -204,9 +204,10 @@ pub struct GrainPackParams {
     /// Nodes per grain in the first relaxation stage (≥ 32).
     pub coarse_nodes: usize,
     /// Nodes per grain in the final stage (≥ `coarse_nodes`), or 0
-    /// (default) for the cube-map directions of the grains' tables: the
-    /// vertices of the tabulated surface, so a rough surface cannot reach
-    /// between nodes (1734 for 16 cells per face).
+    /// (default) for the cube-map directions of the grains' tables (refined
+    /// to at least 16 cells per face): the vertices of the tabulated
+    /// surface, so a rough surface cannot reach between nodes (1734 for 16
+    /// cells per face).
     pub fine_nodes: usize,
     /// Sweeps allowed over both stages before [`Error::NotConverged`].
     pub max_sweeps: usize,

@@ -69,7 +69,10 @@ impl<'a> Shapes<'a> {
     /// a rough surface lies between them but the sagitta of a table cell).
     pub(super) fn new(grains: &'a [StarGrain], k: usize) -> Self {
         let dirs = if k == 0 {
+            // At least 16 cells per face (a multiple of the tables', so
+            // their vertices are among the nodes).
             let f = grains.iter().map(StarGrain::face_cells).max().unwrap_or(2);
+            let f = f * 16usize.div_ceil(f);
             levelset::cube_map_directions(f)
                 .map(|d| d.into_iter().map(|u| u.into_inner()).collect())
                 .unwrap_or_else(|_| fibonacci(6 * (f + 1) * (f + 1)))
