@@ -656,6 +656,46 @@ impl CloneModel {
         Ok(grid)
     }
 
+    /// The clone's surface as a cube-map radius table: `out[t]` is the
+    /// radius in direction `levelset::cube_map_directions(face_cells)[t]` of
+    /// the clone frame (major axis +x, minor +z, centre at the origin), by
+    /// the model's interpolation of the node radii — the table
+    /// [`CloneModel::rasterise_at`] hands to `levelset::Grid::from_star_table`
+    /// when `face_cells` is 32 (bit for bit), coarser or finer otherwise.
+    /// For packers that keep a compact star-shaped surface instead of a grid
+    /// (e.g. `packer_quadtree::StarGrain::from_table(face_cells, &table)`).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a radii vector of the wrong length or
+    /// with a non-positive entry; levelset's error for `face_cells` outside
+    /// 2..=4096.
+    pub fn star_table(&self, radii: &[f64], face_cells: usize) -> Result<Vec<f64>> {
+        if radii.len() != self.geom.n_nodes() {
+            return Err(Error::InvalidParameter {
+                name: "radii",
+                value: radii.len() as f64,
+                reason: "one radius per mesh node",
+            });
+        }
+        if let Some(bad) = radii.iter().find(|r| !(r.is_finite() && **r > 0.0)) {
+            return Err(Error::InvalidParameter {
+                name: "radii",
+                value: *bad,
+                reason: "finite and positive",
+            });
+        }
+        if face_cells == 32 && self.cube.len() == 6 * 33 * 33 {
+            return Ok(self.cube.iter().map(|p| self.geom.eval(p, radii)).collect());
+        }
+        let dirs = levelset::cube_map_directions(face_cells).map_err(Error::from)?;
+        Ok(self
+            .geom
+            .plans(&dirs, self.params.interpolation)
+            .iter()
+            .map(|p| self.geom.eval(p, radii))
+            .collect())
+    }
+
     /// Clone `index`: candidates on the stream `(seed, index)` until one is
     /// accepted.
     ///

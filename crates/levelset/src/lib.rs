@@ -120,6 +120,6 @@ pub use mesh::{FAR_ERROR_CELLS, MESH_BAND_CELLS, MeshDistance, MeshRepair, Orien
 pub use properties::{MassProperties, Principal};
 pub use shapes::{Cuboid, Cylinder, Ellipsoid, Shape, Sphere, Superellipsoid};
 pub use star::{
-    BAND_CELLS, DirectionTable, Redistance, StarBuild, StarParams, cube_map_directions,
+    BAND_CELLS, DirectionTable, Redistance, StarBuild, StarParams, StarTable, cube_map_directions,
 };
 pub use surface::Surface;

@@ -178,8 +178,76 @@ pub struct StarBuild {
     pub radius_calls: usize,
 }
 
+/// A star-shaped surface `r(u)` tabulated on a cube map, with the bilinear lookup of
+/// [`Grid::from_star_table`]: the same radius function the grid builder interpolates, for
+/// callers that need the surface itself (packers, node generators) without a grid.
+/// Stored as f32 (`6·(face_cells+1)²` values: 6.9 KB for 16 cells per face, 26 KB for 32).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StarTable {
+    map: CubeMap,
+}
+
+impl StarTable {
+    /// The table from the radii at `cube_map_directions(face_cells)`, in that order.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for `face_cells` outside 2..=4096 or a wrong number of
+    /// radii; [`Error::InvalidRadius`] for a radius that is not finite and positive.
+    pub fn new(face_cells: usize, radii: &[f64]) -> Result<Self> {
+        StarParams {
+            table: DirectionTable::CubeMap { face_cells },
+            ..StarParams::default()
+        }
+        .validate()?;
+        let m = face_cells + 1;
+        if radii.len() != 6 * m * m {
+            return Err(Error::InvalidParameter {
+                name: "radii",
+                value: radii.len() as f64,
+                requirement: "6·(face_cells + 1)² values, one per cube-map direction",
+            });
+        }
+        Ok(Self {
+            map: CubeMap::from_values(face_cells, radii.iter().copied())?,
+        })
+    }
+
+    /// Cells per face edge.
+    pub fn face_cells(&self) -> usize {
+        self.map.n
+    }
+
+    /// The tabulated radii (as stored, f32 widened), in `cube_map_directions` order.
+    pub fn radii(&self) -> Vec<f64> {
+        self.map.radii.iter().map(|&r| f64::from(r)).collect()
+    }
+
+    /// Bilinearly interpolated radius in direction `d` (need not be unit; the zero vector
+    /// or a non-finite one reads as +x).
+    #[inline]
+    pub fn radius(&self, d: &Vector3<f64>) -> f64 {
+        let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
+        if m > 0.0 && m.is_finite() {
+            self.map.radius(d)
+        } else {
+            self.map.radius(&Vector3::x())
+        }
+    }
+
+    /// Largest and smallest tabulated radius (the extremes of the interpolated surface).
+    pub fn extremes(&self) -> (f64, f64) {
+        self.map
+            .radii
+            .iter()
+            .fold((0.0_f64, f64::INFINITY), |(hi, lo), &r| {
+                (hi.max(f64::from(r)), lo.min(f64::from(r)))
+            })
+    }
+}
+
 /// Cube-map table of radii: face f = 2·axis + (negative ? 1 : 0); node (p, q) of a face is
 /// the direction `s·e_axis + u·e_b + v·e_c` with u, v = −1 + 2p/n, −1 + 2q/n.
+#[derive(Debug, Clone, PartialEq)]
 struct CubeMap {
     n: usize,
     /// f32: the 6·33² table of the default fits in L1 (52 KB as f64 does not); relative

@@ -172,6 +172,30 @@ pub enum Error {
         /// What parry reported.
         reason: String,
     },
+    /// A grain's star table or its rasterisation was refused by levelset.
+    #[error("star grain: {0}")]
+    StarTable(levelset::Error),
+    /// The grains fill too much of the container to be packed (or the
+    /// sphere skeleton could not place them all).
+    #[error("grains fill {fraction} of the container, more than can be packed (limit {limit})")]
+    TooDense {
+        /// Grain volume over container volume.
+        fraction: f64,
+        /// The largest fraction attempted.
+        limit: f64,
+    },
+    /// Overlap removal did not finish within the allowed sweeps.
+    #[error(
+        "overlaps remain after {sweeps} sweeps ({overlapping_pairs} pairs at grain scale {scale})"
+    )]
+    NotConverged {
+        /// Sweeps run.
+        sweeps: usize,
+        /// Pairs still closer than the margin.
+        overlapping_pairs: usize,
+        /// Grain scale reached by the growth (1 = full size).
+        scale: f64,
+    },
     /// An I/O error from a reader or a writer.
     #[error("reading or writing failed: {0}")]
     Io(#[from] std::io::Error),

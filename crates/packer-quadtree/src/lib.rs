@@ -87,6 +87,7 @@ mod error;
 mod ga;
 pub mod gap;
 mod grading;
+pub mod grains3d;
 mod index;
 mod io;
 mod metrics;
@@ -99,6 +100,10 @@ pub use domain::Domain;
 pub use error::{Error, Result};
 pub use ga::{GaParams, GaResult, graded_layers, optimise_porosity};
 pub use grading::{Grading, MixtureComponent, estimate_count};
+pub use grains3d::{
+    CheckParams, Fabric, GrainOverlapReport, GrainPackParams, GrainPackStats, GrainPacking,
+    StarGrain, check_grain_overlaps, container_for, orientation_fabric, pack_grains,
+};
 pub use index::{CellGrid, MxQuadtree, SpatialIndex};
 pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};
 pub use metrics::{

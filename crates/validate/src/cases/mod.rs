@@ -11,7 +11,7 @@ mod packer_quadtree;
 pub mod parents;
 mod perez_morales;
 mod rounding;
-mod specimen;
+pub mod specimen;
 mod sph_harmonics;
 
 /// Every registered case, in a stable order.
