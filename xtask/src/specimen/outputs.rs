@@ -166,7 +166,7 @@ pub(crate) fn lsdem_positions(poses: &[LsdemPose]) -> String {
 /// body → world rotation `R` (world point = `R · morph point + position`,
 /// the convention of its `_pointList = _rotMatrix * _refPointList +
 /// _position`), LS-DEM's matrix equals `R` when the file holds
-/// `q0 = y, q1 = −x, q2 = −z, q3 = w`. [`lsdem_matrix`] is that matrix,
+/// `q0 = y, q1 = −x, q2 = −z, q3 = w`. `lsdem_matrix` is that matrix,
 /// written out as LS-DEM does; the tests check the round trip.
 pub(crate) fn lsdem_quaternion(rotation: &nalgebra::UnitQuaternion<f64>) -> [f64; 4] {
     let q = rotation.quaternion();

@@ -1,6 +1,6 @@
 //! Specimens of cloned grains (issue "Specimens of cloned grains"), the
 //! part that stands today: multi-sphere clumps of calibrated Ottawa clones
-//! for DEM codes without level sets ([`levelset::clump`]: the
+//! for DEM codes without level sets ([`levelset::clump`](fn@levelset::clump): the
 //! distance-transform placement of the CLUMP toolbox on the level set, then
 //! one radius offset that matches the level set's volume). Over 500 clones
 //! of the calibrated configuration (`fixtures/calibrated/gsc2-ottawa.ron`),
@@ -124,7 +124,7 @@ pub const SPECIMEN_FACE_CELLS: usize = 16;
 /// Solid fractions tried in turn by [`pack_specimen`], densest first (the
 /// issue asks ≥ 0.50; today the growth stalls below full size at 0.50 and
 /// 0.45 within [`SPECIMEN_SWEEPS`] on 10 000 clones, see
-/// [`EXPECTED_FAILURES`]).
+/// `EXPECTED_FAILURES`).
 pub const SPECIMEN_FRACTIONS: [f64; 4] = [0.50, 0.45, 0.40, 0.36];
 
 /// Sweeps allowed per fraction.
