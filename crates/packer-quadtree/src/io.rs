@@ -44,7 +44,23 @@ pub fn write_csv(disks: &[Disk], mut w: impl Write) -> Result<()> {
 /// As [`write_csv`].
 pub fn write_vtu(disks: &[Disk], mut w: impl Write) -> Result<()> {
     check(disks)?;
-    let n = disks.len();
+    write_vtu_glyphs(
+        disks.len(),
+        |i| disks[i].radius,
+        |i, w| writeln!(w, "{:e} {:e} 0", disks[i].center.x, disks[i].center.y),
+        &mut w,
+    )
+}
+
+/// A VTU of `n` points with point arrays `radius` and `diameter` (the
+/// 2D and 3D sphere writers): `radius(i)`, and `centre(i, w)` writes point
+/// `i`'s coordinates line.
+pub(crate) fn write_vtu_glyphs<W: Write>(
+    n: usize,
+    radius: impl Fn(usize) -> f64,
+    centre: impl Fn(usize, &mut W) -> std::io::Result<()>,
+    w: &mut W,
+) -> Result<()> {
     writeln!(w, r#"<?xml version="1.0"?>"#)?;
     writeln!(
         w,
@@ -58,8 +74,8 @@ pub fn write_vtu(disks: &[Disk], mut w: impl Write) -> Result<()> {
             w,
             r#"<DataArray type="Float64" Name="{name}" format="ascii">"#
         )?;
-        for d in disks {
-            writeln!(w, "{:e}", f * d.radius)?;
+        for i in 0..n {
+            writeln!(w, "{:e}", f * radius(i))?;
         }
         writeln!(w, "</DataArray>")?;
     }
@@ -69,16 +85,16 @@ pub fn write_vtu(disks: &[Disk], mut w: impl Write) -> Result<()> {
         w,
         r#"<DataArray type="Float64" NumberOfComponents="3" format="ascii">"#
     )?;
-    for d in disks {
-        writeln!(w, "{:e} {:e} 0", d.center.x, d.center.y)?;
+    for i in 0..n {
+        centre(i, w)?;
     }
-    write_vtu_vertex_cells(n, &mut w)
+    write_vtu_vertex_cells(n, w)
 }
 
 /// The end of a VTU of `n` points written as vertex cells: closes the
 /// points array, writes connectivity, offsets and types (VTK_VERTEX) and
 /// closes the file (shared by the 2D and 3D writers).
-pub(crate) fn write_vtu_vertex_cells(n: usize, w: &mut impl Write) -> Result<()> {
+fn write_vtu_vertex_cells(n: usize, w: &mut impl Write) -> Result<()> {
     writeln!(w, "</DataArray>")?;
     writeln!(w, "</Points>")?;
     writeln!(w, "<Cells>")?;

@@ -308,27 +308,6 @@ struct Site {
     /// Registry slot (liveness and the site grid).
     slot: u32,
 }
-impl PartialEq for Site {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Site {}
-impl PartialOrd for Site {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Site {
-    // Reversed: the max-heap pops the lowest key; the same order as
-    // [`Key`].
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.g.total_cmp(&self.g)
-            .then(o.k[2].total_cmp(&self.k[2]))
-            .then(o.slot.cmp(&self.slot))
-    }
-}
-
 /// A waiting site in a heap: its order keys and registry slot (24 bytes;
 /// the site itself stays in the registry). Ties in `z` (a floor layer of
 /// equal spheres) go to the lower slot: slots are handed out in a
@@ -350,7 +329,17 @@ impl PartialOrd for Key {
         Some(self.cmp(o))
     }
 }
+impl Key {
+    fn of(s: &Site) -> Self {
+        Self {
+            g: s.g,
+            z: s.k[2],
+            slot: s.slot,
+        }
+    }
+}
 impl Ord for Key {
+    // Reversed: the max-heap pops the lowest key.
     fn cmp(&self, o: &Self) -> Ordering {
         o.g.total_cmp(&self.g)
             .then(o.z.total_cmp(&self.z))
@@ -645,11 +634,7 @@ impl Sites {
         }
         let cap = self.cap(j);
         self.data[s.slot as usize] = Site { cap, ..s };
-        self.heaps[j].push(Key {
-            g: s.g,
-            z: s.k[2],
-            slot: s.slot,
-        });
+        self.heaps[j].push(Key::of(&s));
         self.len += 1;
     }
     /// The lowest site among the levels that can take radius `r`.
@@ -1420,7 +1405,11 @@ impl<'a> Front3<'a> {
                     this.merge_pending(lag, ready);
                     let mut iter = std::mem::take(&mut spec).into_iter();
                     while let Some((site, o)) = iter.next() {
-                        if lag.sites.peek_for(r_small).is_some_and(|t| t > site) {
+                        if lag
+                            .sites
+                            .peek_for(r_small)
+                            .is_some_and(|t| Key::of(&t) > Key::of(&site))
+                        {
                             // A new site is lower: the sequential loop would
                             // have taken it first.
                             lag.sites.push(site);

@@ -568,35 +568,15 @@ pub fn read_csv3(r: impl BufRead) -> Result<Vec<Sphere>> {
 /// diameter; [`Error::Io`]. Nothing is written on a validation error.
 pub fn write_vtu3(spheres: &[Sphere], mut w: impl Write) -> Result<()> {
     check_with_diameters(spheres)?;
-    let n = spheres.len();
-    writeln!(w, r#"<?xml version="1.0"?>"#)?;
-    writeln!(
-        w,
-        r#"<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">"#
-    )?;
-    writeln!(w, "<UnstructuredGrid>")?;
-    writeln!(w, r#"<Piece NumberOfPoints="{n}" NumberOfCells="{n}">"#)?;
-    writeln!(w, r#"<PointData Scalars="radius">"#)?;
-    for (name, f) in [("radius", 1.0), ("diameter", 2.0)] {
-        writeln!(
-            w,
-            r#"<DataArray type="Float64" Name="{name}" format="ascii">"#
-        )?;
-        for s in spheres {
-            writeln!(w, "{:e}", f * s.radius)?;
-        }
-        writeln!(w, "</DataArray>")?;
-    }
-    writeln!(w, "</PointData>")?;
-    writeln!(w, "<Points>")?;
-    writeln!(
-        w,
-        r#"<DataArray type="Float64" NumberOfComponents="3" format="ascii">"#
-    )?;
-    for s in spheres {
-        writeln!(w, "{:e} {:e} {:e}", s.center.x, s.center.y, s.center.z)?;
-    }
-    crate::io::write_vtu_vertex_cells(n, &mut w)
+    crate::io::write_vtu_glyphs(
+        spheres.len(),
+        |i| spheres[i].radius,
+        |i, w| {
+            let c = spheres[i].center;
+            writeln!(w, "{:e} {:e} {:e}", c.x, c.y, c.z)
+        },
+        &mut w,
+    )
 }
 
 /// Reads back points and the `radius` point array of an ASCII VTK XML

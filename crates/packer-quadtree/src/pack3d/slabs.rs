@@ -34,7 +34,6 @@ use rayon::prelude::*;
 use super::container::Container;
 use super::front::{Front3, Pack3Stats, RunOpts, Start};
 use crate::grading::Grading;
-use crate::packer::FrontOrder;
 
 /// Smallest slab width in units of `d_max` (slabs of one phase must be
 /// more than `2 d_max` apart, and an odd slab's imports must not meet their
@@ -78,11 +77,9 @@ pub(super) struct SlabJob<'a> {
     pub(super) d_hi: f64,
     pub(super) grading: &'a Grading,
     pub(super) seed: u64,
-    pub(super) order: FrontOrder,
-    pub(super) lookahead: usize,
-    pub(super) max_skips: usize,
-    pub(super) max_particles: usize,
-    pub(super) pipeline: bool,
+    /// The front settings of every slab (`max` counts own spheres; the
+    /// pipeline runs only in a phase of one slab).
+    pub(super) opts: RunOpts,
     /// Expected number of spheres of the whole box.
     pub(super) estimate: usize,
 }
@@ -147,11 +144,9 @@ impl SlabJob<'_> {
         f.run(
             &mut next,
             RunOpts {
-                order: self.order,
-                max: self.max_particles.saturating_add(n_imp),
-                lookahead: self.lookahead,
-                max_skips: self.max_skips,
+                max: self.opts.max.saturating_add(n_imp),
                 pipeline,
+                ..self.opts
             },
             Start {
                 region: Some(region),
@@ -213,7 +208,7 @@ impl SlabJob<'_> {
         };
         for parity in [0usize, 1] {
             let ids: Vec<usize> = (parity..n).step_by(2).collect();
-            let pipeline = self.pipeline && ids.len() == 1;
+            let pipeline = self.opts.pipeline && ids.len() == 1;
             let runs: Vec<(Vec<[f64; 4]>, Pack3Stats)> = ids
                 .par_iter()
                 .map(|&j| {
