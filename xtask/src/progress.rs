@@ -57,3 +57,16 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         format!("renaming {} to {}", tmp.display(), path.display())
     })
 }
+
+/// A spinner labelled `label` for a stage without steps (hidden under
+/// `quiet` or off a terminal).
+pub(crate) fn spinner(label: &str, quiet: bool) -> ProgressBar {
+    let pb = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new_spinner()
+    };
+    pb.set_message(label.to_owned());
+    pb.enable_steady_tick(std::time::Duration::from_millis(200));
+    pb
+}

@@ -333,8 +333,9 @@ impl CubeMap {
     /// Interpolated radius for a non-zero (not necessarily unit) direction.
     #[inline(always)]
     fn radius(&self, d: &Vector3<f64>) -> f64 {
-        let inv = [1.0 / d.x.abs(), 1.0 / d.y.abs(), 1.0 / d.z.abs()];
-        self.radius_inv(d.x, d.y, d.z, inv)
+        // Only the reciprocal of the major component is read: one division.
+        let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
+        self.radius_inv(d.x, d.y, d.z, [1.0 / m; 3])
     }
 
     /// [`CubeMap::radius`] with the reciprocals of `|x|, |y|, |z|` given (the builder

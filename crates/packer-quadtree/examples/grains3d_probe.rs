@@ -27,7 +27,12 @@ fn main() {
     println!("grains {:.2}s", t.elapsed().as_secs_f64());
     let c = container_for(&Container::triaxial(1.0), &grains, f).unwrap();
     let t = Instant::now();
-    let p = pack_grains(&grains, &c, &GrainPackParams::default());
+    // ROT=0: translations only (the seed's moves), for comparison.
+    let params = GrainPackParams {
+        rotations: std::env::var("ROT").map_or(true, |v| v != "0"),
+        ..GrainPackParams::default()
+    };
+    let p = pack_grains(&grains, &c, &params);
     println!("pack {:.2}s", t.elapsed().as_secs_f64());
     let p = match p {
         Ok(p) => p,

@@ -21,25 +21,44 @@
 //!    until every grain has its sphere (so the skeleton fills the container
 //!    up to the lid and the grading is kept: every grain given is packed);
 //! 2. **orientations**: uniformly random rotations (Shoemake) from the
-//!    stream `(seed, index)`: the fabric is isotropic by construction and is
-//!    not changed later (the moves are translations);
+//!    stream `(seed, index)`, so the fabric starts isotropic; the moves turn
+//!    the grains only as much as their contacts ask (the fabric stays near
+//!    isotropic: ‖N − I/3‖ ≈ 0.01 over 10 000 Ottawa clones);
 //! 3. **overlap removal**: Jacobi sweeps over the pairs whose bounding
 //!    spheres meet (a uniform cell grid of centres). The gap of a pair is
 //!    the LS-DEM test both ways: nodes of A (quasi-uniform Fibonacci
 //!    directions, grouped in 32 patches with bounding spheres so that only
-//!    patches near B are looked at) inside B grown by the margin
-//!    `μ = margin·d_eq(B)`, measured radially (`r_B(p̂) + μ − |p|`). An
-//!    overlapping pair is pushed apart along the depth-weighted mean of the
-//!    radial directions of its penetrating nodes, by half the deepest
-//!    penetration plus a quarter margin each; a grain's pushes are averaged
-//!    (times [`GrainPackParams::relaxation`]). Walls are constraints: after
-//!    each sweep a grain whose nodes come closer than `μ` to a wall is
-//!    projected back along the wall normal. Only pairs with a grain moved in
-//!    the previous sweep are tested again (a pair of unmoved grains keeps its
-//!    verdict), so late sweeps are cheap. First with
-//!    [`GrainPackParams::coarse_nodes`] per grain until no pair overlaps,
-//!    then with [`GrainPackParams::fine_nodes`] until none does;
-//! 4. a last pass over every pair records the worst radial gap
+//!    patches near B are looked at) against B grown by the margin
+//!    `μ = margin·d_eq(B)`. An overlapping pair is pushed apart along the
+//!    depth-weighted mean of B's outward normals at its penetrating nodes,
+//!    by half the deepest penetration plus a quarter margin each, applied
+//!    at the depth-weighted contact point: each grain takes the smallest
+//!    rigid move that gives the contact point that displacement (the
+//!    response of a rigid body to an impulse there, with a sphere's
+//!    isotropic inertia `0.1·d_eq²`: translation `t·n`, rotation
+//!    `t·(r × n)/k²`, `t = s/(1 + |r × n|²/k²)`; off with
+//!    [`GrainPackParams::rotations`] = false, the seed's translations).
+//!    A grain's moves are averaged (times [`GrainPackParams::relaxation`],
+//!    1.8: over-relaxed Jacobi, 2.3× fewer sweeps than 1.2 on 2000
+//!    ellipsoids). Walls are constraints: after each sweep a grain whose
+//!    nodes come closer than `μ` to a wall is projected back along the
+//!    wall normal. Only pairs with a grain moved in the previous sweep are
+//!    tested again, from the moved grain, so late sweeps cost only their
+//!    few moving grains. The grains grow from the scale `λ₀` at which each
+//!    fits its skeleton sphere to 1, by half the remaining scale (at least
+//!    0.002) per step once a step is clean.
+//!    - **coarse stage**: [`GrainPackParams::coarse_nodes`] per grain and a
+//!      margin of 2.5 μ, radial gaps `|p| − λ r(p̂)`. The wider margin
+//!      absorbs what the sparse nodes miss between them: with μ the fine
+//!      stage found nearly every contact a hair under the margin and took
+//!      2/3 of the time (2000 Ottawa clones at 0.50: 31 s → 13 s);
+//!    - **fine stage**: [`GrainPackParams::fine_nodes`] (the vertices of
+//!      the grains' tables) and the margin μ, gaps as first-order
+//!      distances `g/|∇g|` of `g(x) = |x| − r(x̂)` (∇g by forward
+//!      differences, for nodes within 4 μ radially): a radial gap
+//!      over-states the distance where the surface is steep, and the level
+//!      sets of the check measure distance;
+//! 4. a last pass over every pair records the worst gap
 //!    ([`GrainPackStats::worst_gap_over_d`], ≥ the margin on success).
 //!
 //! Why: the skeleton gives a uniform, wall-hugging arrangement of the right
@@ -48,11 +67,14 @@
 //! diameter; node tests on a star surface cost one table lookup each and
 //! are exact for the tabulated surface (no grid per grain); the margin
 //! absorbs the difference between the star surface and its rasterised level
-//! set and the sparsity of the nodes between node sets, so the independent
-//! check on grids passes (see [`check_grain_overlaps`]). The density is set
-//! by the container ([`container_for`] sizes one from the grains and a
-//! target fraction); a target the moves cannot reach ends in
-//! [`Error::NotConverged`] and the caller lowers it.
+//! set, so the independent check on grids passes (see
+//! [`check_grain_overlaps`]). Rotations matter: translations only stall at
+//! 0.45 on 10 000 Ottawa clones and at 0.52 on 2000 random ellipsoids
+//! (overlaps left after 3000 sweeps), where with rotations both converge
+//! (ellipsoids up to 0.56). The density is set by the container
+//! ([`container_for`] sizes one from the grains and a target fraction); a
+//! target the moves cannot reach ends in [`Error::NotConverged`] and the
+//! caller lowers it.
 //!
 //! Determinism: the shuffle and the orientations come from `(seed, index)`
 //! streams; the sweeps compute pair pushes in parallel but accumulate them in
@@ -213,6 +235,11 @@ pub struct GrainPackParams {
     pub max_sweeps: usize,
     /// Factor ω on the averaged push of a grain, in (0, 2).
     pub relaxation: f64,
+    /// Whether a push also turns the grains (the rigid-body response to an
+    /// impulse at the contact point, with a sphere's isotropic inertia);
+    /// `false` keeps the orientations drawn at the start (translations
+    /// only, the seed's moves).
+    pub rotations: bool,
     /// Parameters of the sphere skeleton's advancing front (default: a
     /// look-ahead of 64 sizes, so that a wide grading's large sizes find
     /// room before the front ends).
@@ -228,7 +255,8 @@ impl Default for GrainPackParams {
             coarse_nodes: 160,
             fine_nodes: 0,
             max_sweeps: 3000,
-            relaxation: 1.2,
+            relaxation: 1.8,
+            rotations: true,
             skeleton: Pack3Params {
                 lookahead: 64,
                 ..Pack3Params::default()
@@ -432,7 +460,7 @@ pub fn pack_grains(
             0.5 * scale * ((1.0 - beta) * g.equivalent_diameter() + beta * 2.0 * g.r_max) / g.r_max
         })
         .fold(1.0_f64, f64::min);
-    let centres = relax::relax(
+    let (centres, rotations) = relax::relax(
         grains, container, &rotations, centres, lam0, params, &mut stats,
     )?;
     let poses = centres

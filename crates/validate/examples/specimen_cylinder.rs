@@ -56,6 +56,8 @@ fn main() {
             let t1 = Instant::now();
             let params = packer_quadtree::GrainPackParams {
                 max_sweeps: sweeps,
+                seed: std::env::var("SEED").map_or(1, |v| v.parse().unwrap()),
+                coarse_nodes: std::env::var("COARSE").map_or(160, |v| v.parse().unwrap()),
                 ..Default::default()
             };
             match packer_quadtree::pack_grains(&grains, &c, &params) {

@@ -24,7 +24,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use cloner::{Calibrated, CloneModel, Hooks};
 use nalgebra::{Isometry3, Point3};
-use packer_quadtree::{Container, Sphere};
+use packer_quadtree::{Container, Sphere, StarGrain};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
@@ -36,7 +36,11 @@ mod scene;
 mod tests;
 
 use outputs::{LsdemPose, PlacedClump, Staging, Surfaces, VtuWriter};
-use scene::{Clones, ContainerSpec, ParentsSpec, Scene};
+use scene::{Clones, ContainerSpec, ParentsSpec, Placement, Scene};
+
+/// Cube-map cells per face of the star tables the grain packer packs (and
+/// the level sets of the outputs are rasterised from: 1734 radii).
+const STAR_FACE_CELLS: usize = 16;
 
 /// Flags of `cargo xtask specimen`.
 #[derive(Debug, Args)]
@@ -299,59 +303,146 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
 
     // place
     let t = Instant::now();
-    let (container, poses, tries) = place_in(scene, &to_place, seed)?;
-    st.ran(
-        "place",
-        t,
-        format!(
-            "{} bounding spheres packed in {}{} (pack3d_sizes, {:?} preset) + isotropic rotations",
-            poses.len(),
-            describe(&container),
-            if tries > 1 {
-                format!(", auto-sized in {tries} tries")
-            } else {
-                String::new()
-            },
-            scene.preset
+    let grains: Option<Vec<StarGrain>> = match scene.placement {
+        Placement::Grains => Some(
+            run.clones
+                .par_iter()
+                .zip(&scales)
+                .map(|(c, s)| {
+                    let radii: Vec<f64> = c.radii.iter().map(|r| r * s).collect();
+                    let table = model
+                        .star_table(&radii, STAR_FACE_CELLS)
+                        .with_context(|| format!("star table of clone {}", c.index))?;
+                    StarGrain::from_table(STAR_FACE_CELLS, &table)
+                        .with_context(|| format!("star table of clone {}", c.index))
+                })
+                .collect::<anyhow::Result<_>>()?,
         ),
-    );
+        Placement::BoundingSpheres => None,
+    };
+    let mut grain_stats = None;
+    let (container, poses) = if let Some(grains) = &grains {
+        let (fixed, auto) = match &scene.container {
+            ContainerSpec::AutoCylinder { solid_fraction } => (None, Some(*solid_fraction)),
+            other => (Some(fixed_container(other)), None),
+        };
+        let pb = crate::progress::spinner("packing grains", quiet);
+        let gp = place::place_grains(grains, fixed, auto, scene.preset, seed)?;
+        pb.finish_and_clear();
+        let s = gp.stats;
+        st.ran(
+            "place",
+            t,
+            format!(
+                "{} grains (star tables, {STAR_FACE_CELLS} cells per cube face) packed in {}{} by pack_grains ({:?} skeleton): solid fraction {:.4}, {} + {} sweeps, worst gap / d {:.2e}",
+                poses_len(grains),
+                describe(&gp.container),
+                if gp.tries > 1 {
+                    format!(", auto-sized in {} tries", gp.tries)
+                } else {
+                    String::new()
+                },
+                scene.preset,
+                s.solid_fraction,
+                s.coarse_sweeps,
+                s.fine_sweeps,
+                s.worst_gap_over_d,
+            ),
+        );
+        grain_stats = Some(s);
+        (gp.container, gp.poses)
+    } else {
+        let (container, poses, tries) = place_in(scene, &to_place, seed)?;
+        st.ran(
+            "place",
+            t,
+            format!(
+                "{} bounding spheres packed in {}{} (pack3d_sizes, {:?} preset) + isotropic rotations",
+                poses.len(),
+                describe(&container),
+                if tries > 1 {
+                    format!(", auto-sized in {tries} tries")
+                } else {
+                    String::new()
+                },
+                scene.preset
+            ),
+        );
+        (container, poses)
+    };
 
     // check
     let t = Instant::now();
-    let spheres: Vec<Sphere> = poses
-        .iter()
-        .zip(&bounding)
-        .map(|(p, r)| Sphere {
-            center: Point3::from(p.translation.vector),
-            radius: *r,
-        })
-        .collect();
-    let check = packer_quadtree::check_spheres(&container, &spheres, 1e-9)?;
-    if !check.is_clean(1e-9) {
-        bail!(
-            "the independent checker rejects the placement (worst pair gap / d {:.2e}, wall {:.2e})",
-            check.worst_normalised_gap,
-            check.worst_normalised_wall_gap
+    if let Some(grains) = &grains {
+        let pb = crate::progress::spinner("checking overlaps", quiet);
+        let r = packer_quadtree::check_grain_overlaps(
+            grains,
+            &poses,
+            &container,
+            &packer_quadtree::CheckParams::default(),
+        )?;
+        pb.finish_and_clear();
+        if !r.is_clean() {
+            bail!(
+                "the independent check rejects the grain packing: {} overlapping nodes (worst φ/d {:.2e} between grains {:?}), {} nodes outside the container, {} overlap voxels",
+                r.overlapping_nodes,
+                r.worst_phi_over_d,
+                r.worst_pair,
+                r.nodes_outside,
+                r.raster_overlap_voxels
+            );
+        }
+        let fabric = packer_quadtree::orientation_fabric(&poses, &nalgebra::Vector3::x())?;
+        let fraction = grain_stats.map_or(f64::NAN, |s| s.solid_fraction);
+        st.ran(
+            "check",
+            t,
+            format!(
+                "independent LS-DEM check: {} nodes of 1000 per grain sampled in the neighbours' 32³ level sets, worst φ/d {:.2e} (≥ −1e-6), walls {:.2e}, {} overlap voxels in {} pairs rasterised 4× finer; solid fraction {fraction:.4}; fabric of the major axes ‖N − I/3‖ = {:.4}",
+                r.nodes_checked,
+                r.worst_phi_over_d,
+                r.worst_wall_over_d,
+                r.raster_overlap_voxels,
+                r.raster_pairs,
+                fabric.deviatoric_norm
+            ),
+        );
+    } else {
+        let spheres: Vec<Sphere> = poses
+            .iter()
+            .zip(&bounding)
+            .map(|(p, r)| Sphere {
+                center: Point3::from(p.translation.vector),
+                radius: *r,
+            })
+            .collect();
+        let check = packer_quadtree::check_spheres(&container, &spheres, 1e-9)?;
+        if !check.is_clean(1e-9) {
+            bail!(
+                "the independent checker rejects the placement (worst pair gap / d {:.2e}, wall {:.2e})",
+                check.worst_normalised_gap,
+                check.worst_normalised_wall_gap
+            );
+        }
+        let sphere_fraction = packer_quadtree::solid_fraction(&container, &spheres)?;
+        let grain_volume: f64 = run
+            .clones
+            .iter()
+            .zip(&scales)
+            .map(|(c, s)| c.surface.volume * s.powi(3))
+            .sum();
+        st.ran(
+            "check",
+            t,
+            format!(
+                "independent checker: bounding spheres do not overlap (worst gap / d {:.2e}, walls {:.2e}); solid fraction {:.3} of bounding spheres, {:.3} of grains",
+                check.worst_normalised_gap,
+                check.worst_normalised_wall_gap,
+                sphere_fraction,
+                grain_volume / place::container_volume(&container)
+            ),
         );
     }
-    let sphere_fraction = packer_quadtree::solid_fraction(&container, &spheres)?;
-    let grain_volume: f64 = run
-        .clones
-        .iter()
-        .zip(&scales)
-        .map(|(c, s)| c.surface.volume * s.powi(3))
-        .sum();
-    st.ran(
-        "check",
-        t,
-        format!(
-            "independent checker: bounding spheres do not overlap (worst gap / d {:.2e}, walls {:.2e}); solid fraction {:.3} of bounding spheres, {:.3} of grains",
-            check.worst_normalised_gap,
-            check.worst_normalised_wall_gap,
-            sphere_fraction,
-            grain_volume / container_volume(&container)
-        ),
-    );
 
     // level sets on demand, with the per-grain outputs
     let need = |on: bool, what: &str| {
@@ -394,9 +485,13 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                     let pose = poses[k];
                     let t0 = Instant::now();
                     let radii: Vec<f64> = c.radii.iter().map(|r| r * scales[k]).collect();
-                    let grid = model
-                        .rasterise_at(&radii, res)
-                        .with_context(|| format!("level set of clone {}", c.index))?;
+                    // Grains: the packed star surface itself (the level set the
+                    // check passed); bounding spheres: the model's own table.
+                    let grid = match &grains {
+                        Some(g) => star_grid(&g[k], &radii, params.grid_margin, res),
+                        None => model.rasterise_at(&radii, res).map_err(Into::into),
+                    }
+                    .with_context(|| format!("level set of clone {}", c.index))?;
                     let t1 = Instant::now();
                     ns[0].fetch_add((t1 - t0).as_nanos() as u64, Ordering::Relaxed);
                     let mut g = GrainOut::default();
@@ -733,16 +828,9 @@ fn place_in(
         Ok((c, poses, 1))
     };
     match &scene.container {
-        ContainerSpec::Cylinder { diameter, height } => fixed(Container::Cylinder {
-            base: Point3::origin(),
-            radius: 0.5 * diameter,
-            height: height.unwrap_or(2.0 * diameter),
-        }),
-        ContainerSpec::Box { x, y, z } => fixed(Container::Box {
-            min: Point3::origin(),
-            max: Point3::new(*x, *y, *z),
-            periodic: [false, false],
-        }),
+        spec @ (ContainerSpec::Cylinder { .. } | ContainerSpec::Box { .. }) => {
+            fixed(fixed_container(spec))
+        }
         ContainerSpec::AutoCylinder { solid_fraction } => {
             let v: f64 = clones
                 .iter()
@@ -782,13 +870,46 @@ fn describe(c: &Container) -> String {
     }
 }
 
-fn container_volume(c: &Container) -> f64 {
-    match c {
-        Container::Cylinder { radius, height, .. } => {
-            std::f64::consts::PI * radius * radius * height
-        }
-        Container::Box { min, max, .. } => (max - min).product(),
-        _ => f64::NAN,
+fn poses_len(grains: &[StarGrain]) -> usize {
+    grains.len()
+}
+
+/// The level set of a packed grain: its star table rasterised on the grid
+/// `CloneModel::rasterise_at` would use (`±margin · max node radius`).
+fn star_grid(
+    grain: &StarGrain,
+    radii: &[f64],
+    margin: f64,
+    resolution: usize,
+) -> anyhow::Result<levelset::Grid> {
+    let half = margin * radii.iter().fold(grain.r_max(), |a, b| a.max(*b));
+    let spec = levelset::GridSpec::cube(resolution, -half, half)?;
+    let params = levelset::StarParams {
+        table: levelset::DirectionTable::CubeMap {
+            face_cells: grain.face_cells(),
+        },
+        ..levelset::StarParams::default()
+    };
+    let (grid, _) =
+        levelset::Grid::from_star_table(spec, &Point3::origin(), &grain.table_radii(), &params)?;
+    Ok(grid)
+}
+
+/// The container of a fixed-size scene container.
+fn fixed_container(spec: &ContainerSpec) -> Container {
+    match spec {
+        ContainerSpec::Cylinder { diameter, height } => Container::Cylinder {
+            base: Point3::origin(),
+            radius: 0.5 * diameter,
+            height: height.unwrap_or(2.0 * diameter),
+        },
+        ContainerSpec::Box { x, y, z } => Container::Box {
+            min: Point3::origin(),
+            max: Point3::new(*x, *y, *z),
+            periodic: [false, false],
+        },
+        // sized by the caller
+        ContainerSpec::AutoCylinder { .. } => Container::triaxial(1.0),
     }
 }
 

@@ -16,10 +16,13 @@
 //!                                  // each clone rescaled to a volume-equivalent diameter
 //!                                  // drawn from the grading (by number; `cargo xtask pack` syntax)
 //!     seed: None,                  // default: the calibrated seed
-//!     container: AutoCylinder(solid_fraction: 0.3),
+//!     container: AutoCylinder(solid_fraction: 0.5),
 //!                                  // or Cylinder(diameter: 3000.0, height: None) (H = 2 D),
 //!                                  // or Box(x: 2500.0, y: 2500.0, z: 2500.0); lengths in the parents' unit
-//!     preset: Default,             // or Dense (the sphere packer's presets)
+//!     placement: Grains,           // dense packing of the grains themselves (pack_grains),
+//!                                  // or BoundingSpheres (loose: one sphere per grain)
+//!     preset: Default,             // or Dense (the sphere packer's presets: the bounding
+//!                                  // spheres, or the grain packer's skeleton)
 //!     level_set_resolution: 45,    // nodes per axis of each output level set
 //!     outputs: (
 //!         lsdem: false,            // LS-DEM morph files + poses
@@ -62,7 +65,11 @@ pub(crate) struct Scene {
     pub(crate) seed: Option<u64>,
     /// The container.
     pub(crate) container: ContainerSpec,
-    /// The packer preset.
+    /// How the clones are placed.
+    #[serde(default)]
+    pub(crate) placement: Placement,
+    /// The sphere packer's preset (bounding spheres, or the grain packer's
+    /// skeleton).
     #[serde(default)]
     pub(crate) preset: Preset,
     /// Nodes per axis of every output level set.
@@ -165,10 +172,13 @@ pub(crate) enum ContainerSpec {
         #[serde(default)]
         height: Option<f64>,
     },
-    /// A cylinder with H/D = 2 sized so that the clones' bounding spheres
-    /// fill `solid_fraction` of it, grown by 5 % until every clone fits.
+    /// A cylinder with H/D = 2 sized so that the clones fill
+    /// `solid_fraction` of it (`Grains`: the grains' volume, lowered by 5 %
+    /// per try while the grain packer cannot separate them, at most 6 tries;
+    /// `BoundingSpheres`: the spheres' volume, the cylinder grown by 5 %
+    /// until every sphere fits).
     AutoCylinder {
-        /// Target solid fraction of the bounding spheres, in (0, 0.6].
+        /// Target solid fraction, in (0, 0.7].
         solid_fraction: f64,
     },
     /// A walled box `[0, x] × [0, y] × [0, z]`.
@@ -180,6 +190,19 @@ pub(crate) enum ContainerSpec {
         /// Side along z.
         z: f64,
     },
+}
+
+/// How the clones are placed in the container.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+pub(crate) enum Placement {
+    /// `packer_quadtree::pack_grains`: the star surfaces of the clones
+    /// packed densely without overlap (sphere skeleton, then gap
+    /// minimisation with rotations), checked by `check_grain_overlaps`.
+    #[default]
+    Grains,
+    /// One bounding sphere per clone packed by `pack3d_sizes`, isotropic
+    /// random rotations: non-overlapping by construction, and loose.
+    BoundingSpheres,
 }
 
 /// The sphere packer's preset.
@@ -328,9 +351,9 @@ impl Scene {
                 }
             }
             ContainerSpec::AutoCylinder { solid_fraction } => {
-                if !(*solid_fraction > 0.0 && *solid_fraction <= 0.6) {
+                if !(*solid_fraction > 0.0 && *solid_fraction <= 0.7) {
                     bail!(
-                        "{at}: `container.solid_fraction` must be in (0, 0.6], got {solid_fraction}"
+                        "{at}: `container.solid_fraction` must be in (0, 0.7], got {solid_fraction}"
                     );
                 }
             }

@@ -299,7 +299,11 @@ fn bad_scenes_name_the_key_or_file_and_write_nothing() {
 
 #[test]
 fn the_example_scenes_parse() {
-    for name in ["specimen-clumps.ron", "specimen-lsdem.ron"] {
+    for name in [
+        "specimen-clumps.ron",
+        "specimen-lsdem.ron",
+        "specimen-10k.ron",
+    ] {
         let p = root().join("examples").join(name);
         let s = Scene::read(&p).unwrap_or_else(|e| panic!("{name}: {e:#}"));
         assert!(s.clones.count() >= 1);

@@ -11,6 +11,11 @@ use crate::pack3d::Container;
 /// Patches per node set (each with a bounding sphere per grain).
 const PATCHES: usize = 32;
 
+/// Nodes whose radial gap is under this many margins get the first-order
+/// distance `g/|∇g|` (3 more lookups); farther ones count as clear (a
+/// surface steeper than |∇g| = 4, 75° off radial, is not resolved).
+const SLOPE_LIMIT: f64 = 4.0;
+
 /// Extra push beyond the deepest penetration, in margins.
 const OVERSHOOT: f64 = 0.25;
 
@@ -61,13 +66,15 @@ pub(super) struct Shapes<'a> {
     nodes: Vec<[f32; 3]>,
     /// `patches[i·PATCHES + p]`: centre and radius of patch p of grain i.
     patches: Vec<[f32; 4]>,
+    /// Gaps as first-order distances `g/|∇g|` (else radial gaps).
+    slope: bool,
 }
 
 impl<'a> Shapes<'a> {
     /// `k` Fibonacci nodes per grain, or with `k = 0` the directions of the
     /// grains' cube map (the vertices of the tabulated surface: nothing of
     /// a rough surface lies between them but the sagitta of a table cell).
-    pub(super) fn new(grains: &'a [StarGrain], k: usize) -> Self {
+    pub(super) fn new(grains: &'a [StarGrain], k: usize, slope: bool) -> Self {
         let dirs = if k == 0 {
             // At least 16 cells per face (a multiple of the tables', so
             // their vertices are among the nodes).
@@ -118,6 +125,7 @@ impl<'a> Shapes<'a> {
             set,
             nodes,
             patches,
+            slope,
         }
     }
 
@@ -164,25 +172,44 @@ impl<'a> Shapes<'a> {
                 }
                 acc.tested += 1;
                 let rho = rr.sqrt();
-                let gap = rho - lam * gb.radius(&q);
+                let radial = rho - lam * gb.radius(&q);
+                let limit = if self.slope { SLOPE_LIMIT } else { 1.0 };
+                if radial >= limit * mu_b || rho == 0.0 {
+                    // Beyond reach of the margin even on the steepest
+                    // slope allowed for (|∇g| ≤ SLOPE_LIMIT).
+                    acc.min_gap = acc.min_gap.min(radial / limit / d_b);
+                    continue;
+                }
+                // First-order distance to B's surface: g/|∇g| with g(x) =
+                // |x| − λ r(x̂) (|∇g| ≥ 1: the radial gap over-states the
+                // distance where the surface is steep; the level sets of
+                // the check measure distance), ∇g by forward differences.
+                let h = 1e-3 * lam * gb.r_max();
+                let mut grad = Vector3::zeros();
+                for k in 0..3 {
+                    let mut x = q;
+                    x[k] += h;
+                    grad[k] = (x.norm() - lam * gb.radius(&x) - radial) / h;
+                }
+                let len = grad.norm();
+                let (gap, nrm) = if len > 0.0 {
+                    let g = if self.slope {
+                        radial / len.max(1.0)
+                    } else {
+                        radial
+                    };
+                    (g, grad / len)
+                } else {
+                    (radial, q / rho)
+                };
                 acc.min_gap = acc.min_gap.min(gap / d_b);
                 if gap < mu_b {
                     let depth = mu_b - gap;
                     acc.depth = acc.depth.max(depth);
-                    if rho > 0.0 {
-                        // Outward normal of B's surface: the gradient of
-                        // g(x) = |x| − λ r(x̂) by forward differences.
-                        let h = 1e-3 * lam * gb.r_max();
-                        let mut grad = Vector3::zeros();
-                        for k in 0..3 {
-                            let mut x = q;
-                            x[k] += h;
-                            grad[k] = (x.norm() - lam * gb.radius(&x) - gap) / h;
-                        }
-                        let len = grad.norm();
-                        let nrm = if len > 0.0 { grad / len } else { q / rho };
-                        acc.dir += (sign * depth) * (pose_b.0 * nrm);
-                    }
+                    // Outward normal of B's surface at the node.
+                    acc.dir += (sign * depth) * (pose_b.0 * nrm);
+                    acc.point += depth * (pose_b.0 * q + pose_b.1);
+                    acc.weight += depth;
                 }
             }
         }
@@ -214,6 +241,10 @@ impl<'a> Shapes<'a> {
 #[derive(Debug, Clone, Copy)]
 struct Acc {
     dir: Vector3<f64>,
+    /// Depth-weighted sum of the world positions of penetrating nodes.
+    point: Vector3<f64>,
+    /// Sum of the depths (the weight of `point`).
+    weight: f64,
     depth: f64,
     min_gap: f64,
     tested: u64,
@@ -223,6 +254,8 @@ impl Acc {
     fn new() -> Self {
         Self {
             dir: Vector3::zeros(),
+            point: Vector3::zeros(),
+            weight: 0.0,
             depth: 0.0,
             min_gap: f64::INFINITY,
             tested: 0,
@@ -325,13 +358,26 @@ impl Cells {
     }
 
     /// Calls `f(j)` once for every `j > i` whose box meets grain `i`'s.
-    fn pairs_of(&self, i: usize, c: &[Vector3<f64>], reach: &[f64], mut f: impl FnMut(usize)) {
+    fn pairs_of(&self, i: usize, c: &[Vector3<f64>], reach: &[f64], f: impl FnMut(usize)) {
+        self.meeting(i, c, reach, true, f);
+    }
+
+    /// Calls `f(j)` once for every `j ≠ i` (only `j > i` when `upper`)
+    /// whose box meets grain `i`'s.
+    fn meeting(
+        &self,
+        i: usize,
+        c: &[Vector3<f64>],
+        reach: &[f64],
+        upper: bool,
+        mut f: impl FnMut(usize),
+    ) {
         let (lo_i, hi_i) = (c[i].add_scalar(-reach[i]), c[i].add_scalar(reach[i]));
         let (a, b) = (self.coord(&lo_i), self.coord(&hi_i));
         self.for_cells(&a, &b, |id| {
             for &j in &self.items[self.start[id] as usize..self.start[id + 1] as usize] {
                 let j = j as usize;
-                if j <= i {
+                if j == i || (upper && j < i) {
                     continue;
                 }
                 let lo_j = c[j].add_scalar(-reach[j]);
@@ -350,14 +396,39 @@ impl Cells {
 /// One pair verdict: push `a` along `dir` (and `b` against it) by `step`.
 struct Push {
     b: usize,
-    dir: Vector3<f64>,
-    step: f64,
+    /// Translation and rotation (scaled axis) of `a`.
+    move_a: (Vector3<f64>, Vector3<f64>),
+    /// Translation and rotation (scaled axis) of `b`.
+    move_b: (Vector3<f64>, Vector3<f64>),
     depth_over_d: f64,
+}
+
+/// The smallest rigid move (in the metric of an isotropic inertia `k2`)
+/// that moves the contact point at arm `r` from the centre by `step` along
+/// the unit `n`: translation `t·n` and rotation `t·(r × n)/k2`, with
+/// `t = step / (1 + |r × n|²/k2)` (the response of a rigid body to an
+/// impulse along `n` at `r`). Without rotations (`k2 = ∞`): `step·n`.
+fn rigid_move(
+    r: &Vector3<f64>,
+    n: &Vector3<f64>,
+    step: f64,
+    k2: f64,
+) -> (Vector3<f64>, Vector3<f64>) {
+    if !k2.is_finite() {
+        return (step * n, Vector3::zeros());
+    }
+    let arm = r.cross(n);
+    let t = step / (1.0 + arm.norm_squared() / k2);
+    (t * n, (t / k2) * arm)
 }
 
 /// Geometry shared by the sweeps.
 struct Frame {
+    quats: Vec<UnitQuaternion<f64>>,
     rots: Vec<Matrix3<f64>>,
+    /// Squared radius of gyration of each grain (`0.1·d_eq²`, a sphere's),
+    /// or `+inf` when the moves are translations only.
+    k2: Vec<f64>,
     d_eq: Vec<f64>,
     mu: Vec<f64>,
     reach: Vec<f64>,
@@ -374,7 +445,22 @@ impl Frame {
         acc
     }
 
-    /// Pairs `(i, j > i)` in reach, filtered by `keep(i, j)`.
+    /// Grains `j ≠ i` in reach of `i`.
+    fn for_neighbours(
+        &self,
+        cells: &Cells,
+        c: &[Vector3<f64>],
+        i: usize,
+        mut f: impl FnMut(usize),
+    ) {
+        cells.meeting(i, c, &self.reach, false, |j| {
+            if (c[i] - c[j]).norm_squared() < (self.reach[i] + self.reach[j]).powi(2) {
+                f(j);
+            }
+        });
+    }
+
+    /// Pairs `(i, j > i)` in reach.
     fn for_pairs(&self, cells: &Cells, c: &[Vector3<f64>], i: usize, mut f: impl FnMut(usize)) {
         cells.pairs_of(i, c, &self.reach, |j| {
             if (c[i] - c[j]).norm_squared() < (self.reach[i] + self.reach[j]).powi(2) {
@@ -383,6 +469,9 @@ impl Frame {
         });
     }
 }
+
+/// Centres and orientations of the grains.
+type Poses = (Vec<Vector3<f64>>, Vec<UnitQuaternion<f64>>);
 
 /// Relaxes the skeleton centres until no pair and no wall is closer than
 /// the margin (fine node set), or [`Error::NotConverged`].
@@ -394,19 +483,34 @@ pub(super) fn relax(
     lam0: f64,
     params: &GrainPackParams,
     stats: &mut GrainPackStats,
-) -> Result<Vec<Vector3<f64>>> {
+) -> Result<Poses> {
     let n = grains.len();
     let d_eq: Vec<f64> = grains.iter().map(StarGrain::equivalent_diameter).collect();
-    let mu: Vec<f64> = d_eq.iter().map(|d| params.margin * d).collect();
+    let mu: Vec<f64> = d_eq
+        .iter()
+        .map(|d| COARSE_MARGIN * params.margin * d)
+        .collect();
     let reach: Vec<f64> = grains.iter().zip(&mu).map(|(g, m)| g.r_max() + m).collect();
     let mut sorted = reach.clone();
     sorted.sort_by(f64::total_cmp);
     let cell = 2.0 * sorted[sorted.len() / 2];
-    let frame = Frame {
+    let k2 = d_eq
+        .iter()
+        .map(|d| {
+            if params.rotations {
+                0.1 * d * d
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect();
+    let mut frame = Frame {
+        quats: rotations.to_vec(),
         rots: rotations
             .iter()
             .map(|q| q.to_rotation_matrix().into_inner())
             .collect(),
+        k2,
         d_eq,
         mu,
         reach,
@@ -415,14 +519,14 @@ pub(super) fn relax(
     let mut sweeps = 0;
     let mut first = true;
     let omega = params.relaxation;
-    let coarse = Shapes::new(grains, params.coarse_nodes);
+    let coarse = Shapes::new(grains, params.coarse_nodes, false);
     let mut lam = lam0.clamp(0.5, 1.0);
     let mut moved = vec![true; n];
     // Growth: relax at scale λ until clean, then grow λ towards 1.
     loop {
         let budget = if lam < 1.0 { GROWTH_SWEEPS } else { usize::MAX };
         let clean = relax_at(
-            &frame,
+            &mut frame,
             &coarse,
             container,
             &mut centres,
@@ -445,10 +549,15 @@ pub(super) fn relax(
         }
     }
     drop(coarse);
-    let shapes = Shapes::new(grains, params.fine_nodes);
+    // The fine stage keeps the margin asked for: the coarse stage's wider
+    // one leaves room for what its sparse nodes miss.
+    for (m, d) in frame.mu.iter_mut().zip(&frame.d_eq) {
+        *m = params.margin * d;
+    }
+    let shapes = Shapes::new(grains, params.fine_nodes, true);
     moved.fill(true);
     relax_at(
-        &frame,
+        &mut frame,
         &shapes,
         container,
         &mut centres,
@@ -484,14 +593,20 @@ pub(super) fn relax(
     stats.worst_gap_over_d = fin.iter().map(|f| f.0).fold(f64::INFINITY, f64::min);
     stats.near_pairs = fin.iter().map(|f| f.1).sum();
     stats.worst_wall_over_d = fin.iter().map(|f| f.2).fold(f64::INFINITY, f64::min);
-    Ok(centres)
+    Ok((centres, frame.quats))
 }
+
+/// The coarse stage's margin, in margins: what the coarse nodes miss of a
+/// neighbour's surface (the sagitta between nodes) is absorbed by the
+/// extra half margin, so the fine stage starts with few pairs under the
+/// margin instead of nearly every contact just under it.
+const COARSE_MARGIN: f64 = 2.5;
 
 /// Sweeps per growth step before the step is judged (the scale is not
 /// grown until the step is clean).
 const GROWTH_SWEEPS: usize = 40;
 /// Fraction of the remaining scale grown per clean step.
-const GROWTH: f64 = 0.25;
+const GROWTH: f64 = 0.5;
 /// Smallest growth step.
 const MIN_STEP: f64 = 0.002;
 
@@ -500,7 +615,7 @@ const MIN_STEP: f64 = 0.002;
 /// [`Error::NotConverged`] past `max_sweeps` in total.
 #[allow(clippy::too_many_arguments)]
 fn relax_at(
-    frame: &Frame,
+    frame_mut: &mut Frame,
     shapes: &Shapes<'_>,
     container: &Container,
     centres: &mut [Vector3<f64>],
@@ -515,6 +630,7 @@ fn relax_at(
 ) -> Result<bool> {
     let n = centres.len();
     for _ in 0..budget {
+        let frame: &Frame = frame_mut;
         if *sweeps >= max_sweeps {
             let cells = Cells::new(centres, &frame.reach, frame.cell);
             let c: &[Vector3<f64>] = centres;
@@ -540,14 +656,17 @@ fn relax_at(
         let cells = Cells::new(centres, &frame.reach, frame.cell);
         let c: &[Vector3<f64>] = centres;
         let mv: &[bool] = moved;
-        let found: Vec<(Vec<Push>, u64)> = (0..n)
-            .into_par_iter()
+        // Only pairs with a moved grain: each is tested from its moved
+        // grain (the lower one when both moved).
+        let active: Vec<usize> = (0..n).filter(|&i| mv[i]).collect();
+        let found: Vec<(usize, Vec<Push>, u64)> = active
+            .par_iter()
             .with_min_len(16)
-            .map(|i| {
+            .map(|&i| {
                 let mut out = Vec::new();
                 let mut tests = 0;
-                frame.for_pairs(&cells, c, i, |j| {
-                    if !(mv[i] || mv[j]) {
+                frame.for_neighbours(&cells, c, i, |j| {
+                    if mv[j] && j < i {
                         return;
                     }
                     tests += 1;
@@ -562,26 +681,35 @@ fn relax_at(
                         let len = dir.norm();
                         let dir = if len > 0.0 { dir / len } else { Vector3::z() };
                         let extra = OVERSHOOT * frame.mu[i].max(frame.mu[j]);
+                        let step = 0.5 * (acc.depth + extra);
+                        let x = if acc.weight > 0.0 {
+                            acc.point / acc.weight
+                        } else {
+                            0.5 * (c[i] + c[j])
+                        };
                         out.push(Push {
                             b: j,
-                            dir,
-                            step: 0.5 * (acc.depth + extra),
+                            move_a: rigid_move(&(x - c[i]), &dir, step, frame.k2[i]),
+                            move_b: rigid_move(&(x - c[j]), &(-dir), step, frame.k2[j]),
                             depth_over_d: acc.depth / frame.d_eq[i].min(frame.d_eq[j]),
                         });
                     }
                 });
-                (out, tests)
+                (i, out, tests)
             })
             .collect();
         let mut disp = vec![Vector3::zeros(); n];
+        let mut turn = vec![Vector3::zeros(); n];
         let mut count = vec![0u32; n];
         let mut overlaps = 0;
         let mut deepest = 0.0_f64;
-        for (i, (list, tests)) in found.iter().enumerate() {
+        for &(i, ref list, tests) in &found {
             stats.pair_tests += tests;
             for p in list {
-                disp[i] += p.step * p.dir;
-                disp[p.b] -= p.step * p.dir;
+                disp[i] += p.move_a.0;
+                turn[i] += p.move_a.1;
+                disp[p.b] += p.move_b.0;
+                turn[p.b] += p.move_b.1;
                 count[i] += 1;
                 count[p.b] += 1;
                 overlaps += 1;
@@ -593,12 +721,20 @@ fn relax_at(
             stats.initial_depth_over_d = deepest;
             *first = false;
         }
+        let frame = &mut *frame_mut;
         for i in 0..n {
             moved[i] = count[i] > 0;
             if moved[i] {
-                centres[i] += omega * disp[i] / f64::from(count[i]);
+                let k = omega / f64::from(count[i]);
+                centres[i] += k * disp[i];
+                if turn[i] != Vector3::zeros() {
+                    let q = UnitQuaternion::from_scaled_axis(k * turn[i]) * frame.quats[i];
+                    frame.quats[i] = q;
+                    frame.rots[i] = q.to_rotation_matrix().into_inner();
+                }
             }
         }
+        let frame: &Frame = frame;
         // Walls as constraints: project each grain back inside.
         let c: &[Vector3<f64>] = centres;
         let walls: Vec<Option<Vector3<f64>>> = (0..n)
@@ -646,4 +782,33 @@ fn relax_at(
         }
     }
     Ok(false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// The contact point moves by `step` along `n` (translation plus the
+    /// rotation's velocity at the arm), for any arm; a central push is a
+    /// pure translation; no rotation without inertia.
+    #[test]
+    fn rigid_moves_give_the_contact_point_its_step() {
+        let n = Vector3::new(0.0, 0.0, 1.0);
+        for r in [
+            Vector3::new(0.0, 0.0, 0.5),
+            Vector3::new(0.3, 0.0, 0.4),
+            Vector3::new(0.5, -0.2, 0.0),
+        ] {
+            let (t, w) = rigid_move(&r, &n, 0.01, 0.1);
+            let at_contact = t + w.cross(&r);
+            assert_relative_eq!(at_contact.dot(&n), 0.01, max_relative = 1e-12);
+        }
+        let (t, w) = rigid_move(&Vector3::new(0.0, 0.0, 0.5), &n, 0.01, 0.1);
+        assert_relative_eq!(t.z, 0.01, max_relative = 1e-12);
+        assert_eq!(w, Vector3::zeros());
+        let (t, w) = rigid_move(&Vector3::new(0.5, 0.0, 0.0), &n, 0.01, f64::INFINITY);
+        assert_relative_eq!(t.z, 0.01, max_relative = 1e-12);
+        assert_eq!(w, Vector3::zeros());
+    }
 }
