@@ -556,7 +556,8 @@ fn skeleton(
 }
 
 /// `shape` (a walled box or a cylinder) scaled about its lower corner /
-/// base centre so that the grains' volume fills `fraction` of it.
+/// base centre so that the grains' volume fills `fraction` of it (at least
+/// `fraction`, never a rounding error below).
 ///
 /// # Errors
 /// [`Error::Empty`] without grains; [`Error::Parameter`] for a fraction
@@ -575,7 +576,9 @@ pub fn container_for(shape: &Container, grains: &[StarGrain], fraction: f64) -> 
     }
     shape.validate()?;
     let total: f64 = grains.iter().map(StarGrain::volume).sum();
-    let k = (total / fraction / shape.volume()).cbrt();
+    // Rounded down by a relative 1e-12 so that the grains fill at least
+    // `fraction` of the container (not 1 ulp less).
+    let k = (total / fraction / shape.volume()).cbrt() * (1.0 - 1e-12);
     match shape {
         Container::Box {
             min,

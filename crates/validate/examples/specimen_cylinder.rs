@@ -56,6 +56,7 @@ fn main() {
             let t1 = Instant::now();
             let params = packer_quadtree::GrainPackParams {
                 max_sweeps: sweeps,
+                relaxation: std::env::var("OMEGA").map_or(1.8, |v| v.parse().unwrap()),
                 seed: std::env::var("SEED").map_or(1, |v| v.parse().unwrap()),
                 coarse_nodes: std::env::var("COARSE").map_or(160, |v| v.parse().unwrap()),
                 ..Default::default()

@@ -274,3 +274,21 @@ fn rotations_turn_grains_only_when_asked() {
         assert!(p.stats.worst_wall_over_d >= 0.01 * (1.0 - 1e-6));
     }
 }
+
+/// The container of `container_for` holds at least the fraction asked
+/// (never a rounding error below), boxes and cylinders.
+#[test]
+fn container_for_never_rounds_the_fraction_down() {
+    let g = ellipsoids(37, 4);
+    let total: f64 = g.iter().map(StarGrain::volume).sum();
+    for shape in [
+        Container::triaxial(1.0),
+        Container::walled_box(Vector3::new(1.0, 2.0, 3.0)),
+    ] {
+        for f in [0.3, 0.45, 0.5, 0.51, 0.56, 0.7] {
+            let c = container_for(&shape, &g, f).unwrap_or_else(|e| panic!("{e}"));
+            let got = total / c.volume();
+            assert!(got >= f && got < f * (1.0 + 1e-9), "{f}: {got}");
+        }
+    }
+}
