@@ -1,6 +1,8 @@
 //! Times the stages of the `specimen/cylinder-10k` case (the validate crate
 //! has no clock): `cargo run --release -p validate --example
-//! specimen_cylinder -- [COUNT] [box]`.
+//! specimen_cylinder -- [COUNT] [box]`; `FRACTIONS=0.56,0.53` (tried in
+//! turn), `SWEEPS`, `SEED`, `COARSE` (coarse nodes), `OMEGA`, `ROT=0`
+//! (translations only) override the packer's parameters.
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use levelset::nalgebra::Vector3;
@@ -57,6 +59,7 @@ fn main() {
             let params = packer_quadtree::GrainPackParams {
                 max_sweeps: sweeps,
                 relaxation: std::env::var("OMEGA").map_or(1.8, |v| v.parse().unwrap()),
+                rotations: std::env::var("ROT").map_or(true, |v| v != "0"),
                 seed: std::env::var("SEED").map_or(1, |v| v.parse().unwrap()),
                 coarse_nodes: std::env::var("COARSE").map_or(160, |v| v.parse().unwrap()),
                 ..Default::default()
