@@ -630,11 +630,13 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         Some(r) => st.skip("clumps", &r),
         None => {
             let n: usize = clumps.iter().map(|c| c.spheres.len()).sum();
+            let t = Instant::now();
+            let tr = outputs::separate_clumps(&mut clumps, &container)?;
             st.ran_s(
                 "clumps",
-                cpu(2),
+                cpu(2) + t.elapsed().as_secs_f64(),
                 format!(
-                    "{} clumps, {n} spheres ({:.1} per clump, at most {}){} (CPU)",
+                    "{} clumps, {n} spheres ({:.1} per clump, at most {}){}; {} sphere pairs of different clumps overlapped (worst {:.2e} of the smaller diameter) and {} spheres crossed a wall: {} radii trimmed (at most {:.1} %), summed sphere volume {:+.2} % (CPU)",
                     clumps.len(),
                     n as f64 / clumps.len().max(1) as f64,
                     out.clump.spheres_per_clump,
@@ -642,7 +644,13 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                         format!(", {shrunk} candidate spheres shrunk")
                     } else {
                         String::new()
-                    }
+                    },
+                    tr.pairs,
+                    tr.worst,
+                    tr.walls,
+                    tr.trimmed,
+                    100.0 * tr.max_cut,
+                    100.0 * tr.volume_change
                 ),
             );
         }

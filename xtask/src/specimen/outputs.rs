@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use nalgebra::{Isometry3, Point3};
 use packer_quadtree::{Container, Sphere};
 
@@ -665,4 +665,121 @@ pub(crate) fn poses_csv(
         );
     }
     s
+}
+
+/// Radius trimming of [`separate_clumps`].
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Trim {
+    /// Sphere pairs of different clumps that overlapped.
+    pub(crate) pairs: usize,
+    /// Worst of those overlaps over the smaller sphere's diameter.
+    pub(crate) worst: f64,
+    /// Spheres that crossed a wall.
+    pub(crate) walls: usize,
+    /// Spheres whose radius was trimmed.
+    pub(crate) trimmed: usize,
+    /// Largest relative radius reduction.
+    pub(crate) max_cut: f64,
+    /// Relative change of the summed sphere volumes.
+    pub(crate) volume_change: f64,
+}
+
+/// Makes the clumps of a grain packing a valid DEM start: the clumps
+/// approximate the level sets (their radii are offset to match each
+/// grain's volume), so their spheres may reach past a grain's surface,
+/// across the margin the packer leaves and into a neighbour's spheres or a
+/// wall. Every sphere of a pair of different clumps that overlaps by `δ`
+/// loses `δ/2` (plus 1e-9 of its radius) of radius — the largest cut any of
+/// its pairs asks, so one pass leaves no overlap — and a sphere crossing a
+/// wall is cut to its clearance. Spheres of one clump keep overlapping each
+/// other (they are one rigid body). A uniform cell grid of sphere centres
+/// (cell = the largest diameter): O(spheres).
+///
+/// # Errors
+/// A sphere that would lose more than 90 % of its radius (the packing is
+/// not one a clump of this size can follow).
+pub(crate) fn separate_clumps(
+    clumps: &mut [PlacedClump],
+    container: &Container,
+) -> anyhow::Result<Trim> {
+    let index: Vec<(usize, usize)> = clumps
+        .iter()
+        .enumerate()
+        .flat_map(|(k, c)| (0..c.spheres.len()).map(move |m| (k, m)))
+        .collect();
+    let spheres: Vec<(Point3<f64>, f64, usize)> = clumps
+        .iter()
+        .enumerate()
+        .flat_map(|(k, c)| c.world().map(move |s| (s.center, s.radius, k)))
+        .collect();
+    let mut trim = Trim::default();
+    let Some(r_max) = spheres.iter().map(|s| s.1).reduce(f64::max) else {
+        return Ok(trim);
+    };
+    let cell = 2.0 * r_max;
+    let key = |p: &Point3<f64>| {
+        [
+            (p.x / cell).floor() as i64,
+            (p.y / cell).floor() as i64,
+            (p.z / cell).floor() as i64,
+        ]
+    };
+    let mut grid: std::collections::BTreeMap<[i64; 3], Vec<usize>> =
+        std::collections::BTreeMap::new();
+    for (i, s) in spheres.iter().enumerate() {
+        grid.entry(key(&s.0)).or_default().push(i);
+    }
+    let mut cut = vec![0.0_f64; spheres.len()];
+    for (i, a) in spheres.iter().enumerate() {
+        let clear = container.clearance(&a.0);
+        if clear < a.1 {
+            trim.walls += 1;
+            cut[i] = cut[i].max(a.1 - clear + 1e-9 * a.1);
+        }
+        let k = key(&a.0);
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) else {
+                        continue;
+                    };
+                    for &j in list {
+                        let b = &spheres[j];
+                        if j <= i || b.2 == a.2 {
+                            continue;
+                        }
+                        let overlap = a.1 + b.1 - (a.0 - b.0).norm();
+                        if overlap > 0.0 {
+                            trim.pairs += 1;
+                            trim.worst = trim.worst.max(overlap / (2.0 * a.1.min(b.1)));
+                            cut[i] = cut[i].max(0.5 * overlap + 1e-9 * a.1);
+                            cut[j] = cut[j].max(0.5 * overlap + 1e-9 * b.1);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let (mut before, mut after) = (0.0, 0.0);
+    for (i, &(k, m)) in index.iter().enumerate() {
+        let r = &mut clumps[k].spheres[m].1;
+        before += r.powi(3);
+        if cut[i] > 0.0 {
+            let rel = cut[i] / *r;
+            if rel > 0.9 {
+                bail!(
+                    "clump of clone {}: a sphere of radius {:.4} would lose {:.0} % of it to its neighbours; use more spheres per clump",
+                    clumps[k].index,
+                    *r,
+                    100.0 * rel
+                );
+            }
+            trim.trimmed += 1;
+            trim.max_cut = trim.max_cut.max(rel);
+            *r -= cut[i];
+        }
+        after += r.powi(3);
+    }
+    trim.volume_change = after / before - 1.0;
+    Ok(trim)
 }

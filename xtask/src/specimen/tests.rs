@@ -482,3 +482,72 @@ fn base64_matches_rfc_4648_and_round_trips() {
     let bytes: Vec<u8> = (0..=255u8).cycle().take(1000).collect();
     assert_eq!(super::outputs::base64_decode(&enc(&bytes)), Some(bytes));
 }
+
+/// Spheres of different clumps that overlap, or cross a wall, are trimmed
+/// until none does; spheres of one clump keep their overlap.
+#[test]
+fn separate_clumps_leaves_no_overlap_between_clumps_or_with_walls() {
+    use super::outputs::{PlacedClump, separate_clumps};
+    use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
+    let at =
+        |x: f64| Isometry3::from_parts(Translation3::new(x, 5.0, 5.0), UnitQuaternion::identity());
+    let mut clumps = vec![
+        PlacedClump {
+            index: 0,
+            pose: at(4.0),
+            spheres: vec![(Point3::origin(), 1.0), (Point3::new(0.5, 0.0, 0.0), 1.0)],
+        },
+        PlacedClump {
+            index: 1,
+            pose: at(6.2),
+            spheres: vec![(Point3::origin(), 1.0)],
+        },
+        PlacedClump {
+            index: 2,
+            pose: at(0.5),
+            spheres: vec![(Point3::origin(), 1.0)],
+        },
+    ];
+    let c = packer_quadtree::Container::walled_box(nalgebra::Vector3::new(10.0, 10.0, 10.0));
+    let t = separate_clumps(&mut clumps, &c).expect("trims");
+    assert_eq!(t.walls, 1);
+    assert!(t.pairs == 1 && t.trimmed == 3, "{t:?}");
+    assert!(t.volume_change < 0.0);
+    // sphere (4.5, r) against (6.2, r): overlap 0.3 → each loses 0.15
+    let world: Vec<(Point3<f64>, f64, u64)> = clumps
+        .iter()
+        .flat_map(|k| {
+            k.spheres
+                .iter()
+                .map(move |(p, r)| (k.pose * p, *r, k.index))
+        })
+        .collect();
+    for (i, a) in world.iter().enumerate() {
+        assert!(c.clearance(&a.0) >= a.1, "sphere {i} crosses a wall");
+        for b in &world[i + 1..] {
+            if a.2 != b.2 {
+                assert!((a.0 - b.0).norm() >= a.1 + b.1, "{a:?} {b:?}");
+            }
+        }
+    }
+    // the two spheres of clump 0 still overlap each other
+    let s = &clumps[0].spheres;
+    assert!((s[0].0 - s[1].0).norm() < s[0].1 + s[1].1);
+    // a sphere that would lose nearly all of its radius is an error
+    let mut deep = vec![
+        PlacedClump {
+            index: 0,
+            pose: at(5.0),
+            spheres: vec![(Point3::origin(), 1.0)],
+        },
+        PlacedClump {
+            index: 1,
+            pose: at(5.05),
+            spheres: vec![(Point3::origin(), 1.0)],
+        },
+    ];
+    let e = separate_clumps(&mut deep, &c)
+        .expect_err("too deep")
+        .to_string();
+    assert!(e.contains("spheres per clump"), "{e}");
+}
