@@ -371,8 +371,8 @@ fn stream(seed: u64, index: u64) -> ChaCha8Rng {
     rng
 }
 
-/// A uniformly random rotation (Shoemake 1992) from `rng`.
-fn random_rotation(rng: &mut impl Rng) -> UnitQuaternion<f64> {
+/// A uniformly random (Haar) rotation (Shoemake 1992) from `rng`.
+pub fn random_rotation(rng: &mut impl Rng) -> UnitQuaternion<f64> {
     let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
     let tau = std::f64::consts::TAU;
     let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());

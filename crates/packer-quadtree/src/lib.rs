@@ -103,6 +103,7 @@ pub use grading::{Grading, MixtureComponent, estimate_count};
 pub use grains3d::{
     CheckParams, Fabric, GrainOverlapReport, GrainPackParams, GrainPackStats, GrainPacking,
     StarGrain, check_grain_overlaps, container_for, orientation_fabric, pack_grains,
+    random_rotation,
 };
 pub use index::{CellGrid, MxQuadtree, SpatialIndex};
 pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};

@@ -335,7 +335,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             t,
             format!(
                 "{} grains (star tables, {STAR_FACE_CELLS} cells per cube face) packed in {}{} by pack_grains ({:?} skeleton): solid fraction {:.4}, {} + {} sweeps, worst gap / d {:.2e}",
-                poses_len(grains),
+                grains.len(),
                 describe(&gp.container),
                 if gp.tries > 1 {
                     format!(", auto-sized in {} tries", gp.tries)
@@ -439,7 +439,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 check.worst_normalised_gap,
                 check.worst_normalised_wall_gap,
                 sphere_fraction,
-                grain_volume / place::container_volume(&container)
+                grain_volume / container.volume()
             ),
         );
     }
@@ -876,10 +876,6 @@ fn describe(c: &Container) -> String {
         }
         _ => "a mesh".into(),
     }
-}
-
-fn poses_len(grains: &[StarGrain]) -> usize {
-    grains.len()
 }
 
 /// The level set of a packed grain: its star table rasterised on the grid

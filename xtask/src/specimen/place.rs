@@ -19,11 +19,11 @@
 //! packing would).
 
 use anyhow::bail;
-use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use packer_quadtree::{
     Container, GrainPackParams, GrainPackStats, Pack3Params, StarGrain, container_for, pack_grains,
 };
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 use super::scene::Preset;
@@ -86,7 +86,7 @@ pub(crate) fn place(
     let (lo, hi) = sizes
         .iter()
         .fold((f64::INFINITY, 0.0_f64), |(a, b), d| (a.min(*d), b.max(*d)));
-    let room = inscribed_diameter(container);
+    let room = container.inscribed_diameter();
     if hi > room {
         bail!(
             "`container` is too small for the largest clone: its bounding sphere has diameter {hi:.4}, the container takes at most {room:.4}"
@@ -200,7 +200,7 @@ pub(crate) fn place_grains(
         )
     };
     if let Some(c) = container {
-        let room = inscribed_diameter(&c);
+        let room = c.inscribed_diameter();
         if largest > room {
             bail!(
                 "`container` is too small for the largest clone: its bounding sphere has diameter {largest:.4}, the container takes at most {room:.4}"
@@ -216,7 +216,7 @@ pub(crate) fn place_grains(
             Err(e) if too_dense(&e) => bail!(
                 "`container` cannot take all {} clones: they fill {:.3} of it and the grain packer cannot separate them ({e}); use a larger container or AutoCylinder",
                 grains.len(),
-                total / container_volume(&c)
+                total / c.volume()
             ),
             Err(e) => Err(e.into()),
         };
@@ -225,7 +225,7 @@ pub(crate) fn place_grains(
     let mut last = String::new();
     for tries in 1..=FRACTION_TRIES {
         let c = container_for(&Container::triaxial(1.0), grains, fraction)?;
-        let room = inscribed_diameter(&c);
+        let room = c.inscribed_diameter();
         if largest <= room {
             match pack_grains(grains, &c, &params) {
                 Ok(p) => {
@@ -252,41 +252,12 @@ pub(crate) fn place_grains(
     )
 }
 
-/// Volume of a box or cylinder.
-pub(crate) fn container_volume(c: &Container) -> f64 {
-    match c {
-        Container::Cylinder { radius, height, .. } => {
-            std::f64::consts::PI * radius * radius * height
-        }
-        Container::Box { min, max, .. } => (max - min).product(),
-        _ => f64::NAN,
-    }
-}
-
-/// Diameter of the largest sphere the container takes.
-pub(crate) fn inscribed_diameter(container: &Container) -> f64 {
-    match container {
-        Container::Box { min, max, .. } => (max - min).min(),
-        Container::Cylinder { radius, height, .. } => (2.0 * radius).min(*height),
-        // meshes are not offered by scenes; let the packer decide
-        _ => f64::INFINITY,
-    }
-}
-
 /// An isotropic (Haar-uniform) rotation from the `(seed, index)` stream
 /// (Shoemake's three uniforms).
 pub(crate) fn random_rotation(seed: u64, index: u64) -> UnitQuaternion<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ ROTATION_STREAM);
     rng.set_stream(index);
-    let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
-    let tau = std::f64::consts::TAU;
-    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-    UnitQuaternion::from_quaternion(Quaternion::new(
-        b * (tau * u3).cos(),
-        a * (tau * u2).sin(),
-        a * (tau * u2).cos(),
-        b * (tau * u3).sin(),
-    ))
+    packer_quadtree::random_rotation(&mut rng)
 }
 
 #[cfg(test)]
