@@ -544,7 +544,12 @@ pub(super) fn relax(
             break;
         }
         if clean {
-            lam = (lam + (GROWTH * (1.0 - lam)).max(MIN_STEP)).min(1.0);
+            // Straight to full size once clean at the skeleton's scale: on
+            // 2000 Ottawa clones at 0.50 (3 seeds) steps of half the
+            // remaining scale took 944–2156 sweeps, one step 320–713 (every
+            // step ends in the same slow tail of a few stubborn pairs), and
+            // one step also converges at 0.56 where small steps did not.
+            lam = 1.0;
             moved.fill(true);
         }
     }
@@ -605,15 +610,6 @@ const COARSE_MARGIN: f64 = 2.5;
 /// Sweeps per growth step before the step is judged (the scale is not
 /// grown until the step is clean).
 const GROWTH_SWEEPS: usize = 40;
-/// Fraction of the remaining scale grown per clean step: 1, straight to
-/// full size once the grains are clean at the skeleton's scale. On 2000
-/// Ottawa clones at 0.50 (3 seeds) steps of half the remaining scale took
-/// 944–2156 sweeps, a full step 320–713: every step ends in the same slow
-/// tail of a few stubborn pairs, so fewer steps is faster, and the full
-/// step also converges at 0.56 where the small steps did not.
-const GROWTH: f64 = 1.0;
-/// Smallest growth step (with `GROWTH` < 1).
-const MIN_STEP: f64 = 0.002;
 
 /// Jacobi sweeps at scale `lam` until no pair and no wall is closer than
 /// the margin (`Ok(true)`) or `budget` sweeps (`Ok(false)`);
