@@ -657,6 +657,32 @@ fn union_grid(spheres: &[Ball], eta: f64, reach: f64) -> Result<Grid> {
     Grid::new(spec, psi)
 }
 
+/// Volume, centroid and inertia tensor (per unit density) of the **union** of `spheres`,
+/// each point counted once however many spheres cover it: what a DEM code must be given as
+/// a multi-sphere body's mass and inertia (summing the spheres' own masses over-counts the
+/// overlaps; a 20-sphere clump of real sand sums to about twice its union). The union's
+/// distance is integrated on a lattice of spacing `lattice_spacing` as described in the
+/// module docs (§ Union properties): a unit sphere at 20 lattice cells per radius is within
+/// 0.1 % in volume.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for no spheres, a non-finite centre, a non-positive or
+/// non-finite radius or lattice spacing.
+pub fn union_mass_properties(
+    spheres: &[(Point3<f64>, f64)],
+    lattice_spacing: f64,
+) -> Result<MassProperties> {
+    check_spheres(spheres)?;
+    if !(lattice_spacing.is_finite() && lattice_spacing > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "lattice spacing",
+            value: lattice_spacing,
+            requirement: "finite and positive",
+        });
+    }
+    union_mass(spheres, lattice_spacing)
+}
+
 /// Volume, centroid and inertia of the union of `spheres` (lattice spacing `eta`).
 fn union_mass(spheres: &[Ball], eta: f64) -> Result<MassProperties> {
     union_grid(spheres, eta, 0.0)?.mass_properties()

@@ -108,7 +108,9 @@ pub mod voxel;
 /// Re-export of the vector vocabulary of the API, so callers need no separate pin.
 pub use nalgebra;
 
-pub use clump::{Clump, ClumpParams, ClumpQuality, VolumeCorrection, clump, clump_quality};
+pub use clump::{
+    Clump, ClumpParams, ClumpQuality, VolumeCorrection, clump, clump_quality, union_mass_properties,
+};
 pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};
 pub use grid::{Grid, GridSpec};
