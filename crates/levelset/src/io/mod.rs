@@ -21,6 +21,7 @@
 //! names what is wrong with an open or non-manifold mesh; the caller adds the file name.
 
 mod lammps;
+pub mod lsdem;
 mod morph;
 mod npy;
 mod obj;
@@ -30,6 +31,7 @@ mod tiff_stack;
 mod vtk;
 
 pub use lammps::{read_lammps, write_lammps};
+pub use lsdem::{PrincipalMorph, principal_morph};
 pub use morph::{MorphFile, read_morph, write_morph};
 pub use npy::{read_npy, write_npy};
 pub use obj::{read_obj, write_obj};

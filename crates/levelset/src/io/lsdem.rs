@@ -1,0 +1,463 @@
+//! LS-DEM specimens as LS-DEM reads them: morph files in the grain's principal-axis frame
+//! and the `Morphologies/` + `InitState/` layout with LS-DEM's quaternion convention.
+//!
+//! # Layout
+//! The 3D LS-DEM codes descended from Kawamoto's (Kawamoto, Andò, Viggiani, Andrade 2016,
+//! 2018; e.g. the MPI `init_simulation` of its Berkeley descendant) read, below one input
+//! folder:
+//!
+//! - `InitState/positions_<NAME>.dat`: one `x y z` line per grain (`readPositionFile`),
+//! - `InitState/rotations_<NAME>.dat`: one quaternion `q0 q1 q2 q3` per grain
+//!   (`readQuaternionFile`), in the convention of [`lsdem_quaternion`],
+//! - `Morphologies/morph_<k>.dat` for the `k`-th line (1-based) of the two files above.
+//!
+//! Names come from [`morph_path`], [`positions_path`] and [`rotations_path`].
+//!
+//! # Principal frame
+//! LS-DEM integrates rotations with Euler's equations in the morph frame and reads the three
+//! moments of a morph file as the **diagonal** of the inertia tensor there (zero products of
+//! inertia); `fix rigid/ls/dem` of the LAMMPS LS-DEM fork stops on a grid whose frame is
+//! not principal. [`principal_morph`] therefore resamples a grain's level set onto a lattice
+//! aligned with its principal axes and iterates: the discrete inertia of the resampled grid
+//! (the crate's marching-tetrahedra integral, [`Grid::mass_properties`]) differs slightly
+//! from the source's, so the lattice is turned by the eigenvectors of the resampled grid's
+//! own tensor until its largest product of inertia is below [`PRINCIPAL_TOLERANCE`] of its
+//! largest moment (measured on Ottawa clones: 2–4 resamplings reach 1e-12). The moments
+//! written are that tensor's diagonal in x, y, z order.
+
+use std::io::Write;
+
+use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+
+use super::MorphFile;
+use crate::error::{Error, Result};
+use crate::grid::{Grid, GridSpec};
+
+/// Largest `|I_ij| / max_k I_kk` (i ≠ j) accepted for a principal morph frame.
+pub const PRINCIPAL_TOLERANCE: f64 = 1e-12;
+
+/// Resamplings of [`principal_morph`] before it gives up.
+const MAX_TURNS: usize = 12;
+
+/// Path of the morph file of the `k`-th grain (1-based), relative to LS-DEM's input folder.
+pub fn morph_path(k: usize) -> String {
+    format!("Morphologies/morph_{k}.dat")
+}
+
+/// Path of the positions file of the test `name`, relative to LS-DEM's input folder.
+pub fn positions_path(name: &str) -> String {
+    format!("InitState/positions_{name}.dat")
+}
+
+/// Path of the rotations file of the test `name`, relative to LS-DEM's input folder.
+pub fn rotations_path(name: &str) -> String {
+    format!("InitState/rotations_{name}.dat")
+}
+
+/// A morph file in its grain's principal frame and where that frame sits in the source
+/// grid's frame.
+#[derive(Debug, Clone)]
+pub struct PrincipalMorph {
+    /// The morph file: spacing-1 level set in the principal frame, the moments the diagonal
+    /// of its inertia tensor (x, y, z order), the points relative to the centre of mass.
+    pub morph: MorphFile,
+    /// Morph frame → source frame, in source lengths: a morph point `p` (grid units,
+    /// relative to the centre of mass) is at `frame * (spacing · p)` in the source grid's
+    /// frame. Its translation is the centre of mass in the source frame.
+    pub frame: Isometry3<f64>,
+    /// Source length of one morph grid unit.
+    pub spacing: f64,
+    /// Largest `|I_ij| / max_k I_kk` (i ≠ j) of the written level set's inertia.
+    pub off_diagonal: f64,
+    /// Resamplings done.
+    pub turns: usize,
+}
+
+/// The morph file of `grid` in its principal-axis frame (module docs), resampled
+/// (trilinear) at `spacing` on a cube lattice about the centre of mass that covers the
+/// grain with two cells to spare, with `node_count` surface nodes and mass and moments for
+/// `density` in grid units (as [`MorphFile::from_grid`]).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a non-positive or non-finite spacing or density, or if
+/// the frame does not become principal within 12 resamplings (the message gives the
+/// residual); errors of [`Grid::mass_properties`] and [`Grid::surface_nodes`].
+pub fn principal_morph(
+    grid: &Grid,
+    spacing: f64,
+    density: f64,
+    node_count: usize,
+) -> Result<PrincipalMorph> {
+    for (name, v) in [("spacing", spacing), ("density", density)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(Error::InvalidParameter {
+                name,
+                value: v,
+                requirement: "finite and positive",
+            });
+        }
+    }
+    let mp = grid.mass_properties()?;
+    let centre = mp.centroid;
+    // the farthest inside node bounds the grain about its centre of mass
+    let reach = inside_reach(grid, &centre) + 2.0 * grid.spacing();
+    let cells = (reach / spacing).ceil() as usize + 2;
+    let n = 2 * cells + 1;
+    let half = cells as f64 * spacing;
+    let mut rot = Rotation3::from_matrix_unchecked(right_handed(mp.principal().axes));
+    let mut turns = 0;
+    loop {
+        let frame = Isometry3::from_parts(Translation3::from(centre.coords), rot.into());
+        let spec = GridSpec {
+            dims: [n; 3],
+            origin: Point3::new(-half, -half, -half),
+            spacing,
+        };
+        let local = Grid::from_fn(spec, |p| grid.value(&(frame * p)))?;
+        turns += 1;
+        let lp = local.mass_properties()?;
+        let off = off_diagonal(&lp.inertia);
+        if off <= PRINCIPAL_TOLERANCE {
+            return finish(local, lp, frame, spacing, density, node_count, off, turns);
+        }
+        if turns >= MAX_TURNS {
+            return Err(Error::InvalidParameter {
+                name: "principal frame residual |I_ij| / I_max after 12 resamplings",
+                value: off,
+                requirement: "at most 1e-12",
+            });
+        }
+        // turn by the resampled grid's own eigenvectors (near the identity: keep each axis'
+        // sense and order so that the lattice does not flip)
+        let v = near_identity(lp.principal().axes);
+        rot = Rotation3::from_matrix_unchecked(rot.matrix() * v);
+        rot.renormalize();
+    }
+}
+
+/// Builds the morph file of a principal grid `local` (spacing `h`, origin `−half`).
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    local: Grid,
+    lp: crate::MassProperties,
+    frame: Isometry3<f64>,
+    h: f64,
+    density: f64,
+    node_count: usize,
+    off: f64,
+    turns: usize,
+) -> Result<PrincipalMorph> {
+    let nodes = local.surface_nodes(node_count)?;
+    let origin = local.origin();
+    let points: Vec<Point3<f64>> = nodes
+        .iter()
+        .map(|p| Point3::from((p - lp.centroid) / h))
+        .collect();
+    let bounding_radius = points.iter().map(|p| p.coords.norm()).fold(0.0, f64::max);
+    let spec = GridSpec {
+        dims: local.dims(),
+        origin: Point3::origin(),
+        spacing: 1.0,
+    };
+    let values = local.values().iter().map(|v| v / h).collect();
+    let d = lp.inertia.diagonal();
+    let morph = MorphFile {
+        mass: density * lp.volume / h.powi(3),
+        principal_moments: density * Vector3::new(d.x, d.y, d.z) / h.powi(5),
+        centroid: Point3::from((lp.centroid - origin) / h),
+        points,
+        bounding_radius,
+        grid: Grid::new(spec, values)?,
+    };
+    // the centre of mass of the resampled grid, in the source frame
+    let com = frame * lp.centroid;
+    Ok(PrincipalMorph {
+        morph,
+        frame: Isometry3::from_parts(Translation3::from(com.coords), frame.rotation),
+        spacing: h,
+        off_diagonal: off,
+        turns,
+    })
+}
+
+/// Largest distance from `c` to a node with `φ ≤ 0` (0 for none).
+fn inside_reach(grid: &Grid, c: &Point3<f64>) -> f64 {
+    let [nx, ny, nz] = grid.dims();
+    let mut r2 = 0.0f64;
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                if grid.at(i, j, k) <= 0.0 {
+                    r2 = r2.max((grid.spec().node(i, j, k) - c).norm_squared());
+                }
+            }
+        }
+    }
+    r2.sqrt()
+}
+
+/// `|I_ij|` (i ≠ j) over the largest diagonal term.
+pub fn off_diagonal(inertia: &Matrix3<f64>) -> f64 {
+    let d = inertia.diagonal().amax();
+    let mut off = 0.0f64;
+    for i in 0..3 {
+        for j in 0..3 {
+            if i != j {
+                off = off.max(inertia[(i, j)].abs());
+            }
+        }
+    }
+    if d > 0.0 { off / d } else { f64::INFINITY }
+}
+
+/// `axes` with the last column flipped if needed so that the determinant is +1.
+fn right_handed(mut axes: Matrix3<f64>) -> Matrix3<f64> {
+    if axes.determinant() < 0.0 {
+        let c = -axes.column(2);
+        axes.set_column(2, &c);
+    }
+    axes
+}
+
+/// The eigenvector matrix `v` of a nearly diagonal tensor with its columns permuted and
+/// signed so that it is the rotation nearest the identity (each column's largest component
+/// on the diagonal, positive), and right-handed.
+fn near_identity(v: Matrix3<f64>) -> Matrix3<f64> {
+    let mut out = Matrix3::zeros();
+    let mut used = [false; 3];
+    for c in 0..3 {
+        let col = v.column(c);
+        let mut best = (0usize, -1.0f64);
+        for r in 0..3 {
+            if !used[r] && col[r].abs() > best.1 {
+                best = (r, col[r].abs());
+            }
+        }
+        used[best.0] = true;
+        let s = if col[best.0] < 0.0 { -1.0 } else { 1.0 };
+        out.set_column(best.0, &(col * s));
+    }
+    right_handed(out)
+}
+
+/// The LS-DEM quaternion `[q0, q1, q2, q3]` of a body → world rotation.
+///
+/// LS-DEM (`Grain3d::updateRotationMatrix` of the Kawamoto/Andrade code and its
+/// descendants) stores `(X, Y, Z, W)` but builds its rotation matrix with a sign and axis
+/// convention of its own: for a Hamilton unit quaternion `w + x i + y j + z k` whose matrix
+/// is the body → world rotation `R` (world point = `R · morph point + position`, its
+/// `_pointList = _rotMatrix * _refPointList + _position`), LS-DEM's matrix equals `R` when
+/// the file holds `q0 = y, q1 = −x, q2 = −z, q3 = w`; the sign is chosen so that `q3 ≥ 0`.
+/// [`lsdem_matrix`] is LS-DEM's matrix written out term by term.
+pub fn lsdem_quaternion(rotation: &UnitQuaternion<f64>) -> [f64; 4] {
+    let q = rotation.quaternion();
+    let s = if q.w < 0.0 { -1.0 } else { 1.0 };
+    [s * q.j, -s * q.i, -s * q.k, s * q.w]
+}
+
+/// LS-DEM's rotation matrix of a file quaternion `[q0, q1, q2, q3]`
+/// (`Grain3d::updateRotationMatrix`, term by term): the body → world rotation a simulation
+/// will apply.
+pub fn lsdem_matrix(q: [f64; 4]) -> Matrix3<f64> {
+    let [a, b, c, d] = q;
+    Matrix3::new(
+        -a * a + b * b - c * c + d * d,
+        -2.0 * (a * b - c * d),
+        2.0 * (b * c + a * d),
+        -2.0 * (a * b + c * d),
+        a * a - b * b - c * c + d * d,
+        -2.0 * (a * c - b * d),
+        2.0 * (b * c - a * d),
+        -2.0 * (a * c + b * d),
+        -a * a - b * b + c * c + d * d,
+    )
+}
+
+/// Writes `positions_<NAME>.dat`: `x y z` per line, Rust's shortest round-trip floats.
+///
+/// # Errors
+/// [`Error::Io`] on write failure; [`Error::InvalidParameter`] for a non-finite coordinate.
+pub fn write_positions(mut w: impl Write, positions: &[Point3<f64>]) -> Result<()> {
+    let mut s = String::with_capacity(64 * positions.len());
+    for p in positions {
+        for (k, v) in p.coords.iter().enumerate() {
+            finite("position", *v)?;
+            if k > 0 {
+                s.push(' ');
+            }
+            super::fmt_f64(&mut s, *v);
+        }
+        s.push('\n');
+    }
+    w.write_all(s.as_bytes())?;
+    Ok(())
+}
+
+/// Writes `rotations_<NAME>.dat`: the [`lsdem_quaternion`] of each body → world rotation,
+/// `q0 q1 q2 q3` per line.
+///
+/// # Errors
+/// [`Error::Io`] on write failure; [`Error::InvalidParameter`] for a non-finite rotation.
+pub fn write_rotations(mut w: impl Write, rotations: &[UnitQuaternion<f64>]) -> Result<()> {
+    let mut s = String::with_capacity(96 * rotations.len());
+    for r in rotations {
+        for (k, v) in lsdem_quaternion(r).iter().enumerate() {
+            finite("rotation", *v)?;
+            if k > 0 {
+                s.push(' ');
+            }
+            super::fmt_f64(&mut s, *v);
+        }
+        s.push('\n');
+    }
+    w.write_all(s.as_bytes())?;
+    Ok(())
+}
+
+/// Reads a positions or rotations file: `n` whitespace-separated numbers per non-empty line.
+///
+/// # Errors
+/// [`Error::Parse`] with the line for a line of another length or a bad number; [`Error::Io`].
+pub fn read_rows<const N: usize>(
+    r: impl std::io::BufRead,
+    format: &'static str,
+) -> Result<Vec<[f64; N]>> {
+    let mut rows = Vec::new();
+    for (k, line) in r.lines().enumerate() {
+        let line = line?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let vals: Vec<f64> = line
+            .split_whitespace()
+            .map(str::parse::<f64>)
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|e| Error::Parse {
+                format,
+                line: k + 1,
+                reason: e.to_string(),
+            })?;
+        let row: [f64; N] = vals.try_into().map_err(|v: Vec<f64>| Error::Parse {
+            format,
+            line: k + 1,
+            reason: format!("{} numbers, expected {N}", v.len()),
+        })?;
+        if row.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Parse {
+                format,
+                line: k + 1,
+                reason: "non-finite number".into(),
+            });
+        }
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+fn finite(name: &'static str, v: f64) -> Result<()> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            name,
+            value: v,
+            requirement: "finite",
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shapes::{Ellipsoid, Shape};
+    use approx::assert_relative_eq;
+
+    /// A tilted ellipsoid off the origin: its principal frame is known in closed form.
+    fn tilted() -> (Grid, UnitQuaternion<f64>, Point3<f64>) {
+        let q = UnitQuaternion::from_euler_angles(0.4, -0.3, 1.1);
+        let c = Point3::new(0.1, -0.05, 0.07);
+        let e = Ellipsoid::new(Vector3::new(1.0, 0.7, 0.45)).expect("ellipsoid");
+        let spec = GridSpec::cube(41, -1.3, 1.3).expect("spec");
+        let inv = q.inverse();
+        let g =
+            Grid::from_fn(spec, |p| e.signed_distance(&Point3::from(inv * (p - c)))).expect("grid");
+        (g, q, c)
+    }
+
+    #[test]
+    fn principal_morph_is_diagonal_and_maps_back() {
+        let (g, q, c) = tilted();
+        let h = 0.05;
+        let pm = principal_morph(&g, h, 1.0, 300).expect("morph");
+        assert!(
+            pm.off_diagonal <= PRINCIPAL_TOLERANCE,
+            "{}",
+            pm.off_diagonal
+        );
+        // the written level set, read as LS-DEM has it (spacing 1), is principal too
+        let again = pm.morph.grid.mass_properties().expect("mass");
+        assert!(off_diagonal(&again.inertia) <= 1e-9);
+        // moments in x, y, z order: the ellipsoid's long axis (a = 1) has the smallest
+        let m = pm.morph.principal_moments;
+        assert!(m.x < m.y && m.y < m.z, "{m:?}");
+        // the morph frame's x axis is the ellipsoid's long axis (up to sign)
+        let ax = pm.frame.rotation * Vector3::x();
+        assert_relative_eq!(ax.dot(&(q * Vector3::x())).abs(), 1.0, epsilon = 1e-3);
+        // the centre of mass maps to the ellipsoid's centre
+        assert!((pm.frame.translation.vector - c.coords).norm() < 1e-3);
+        // surface points map back onto the source surface
+        for p in &pm.morph.points {
+            let x = pm.frame * (p * pm.spacing);
+            assert!(g.value(&x).abs() < 0.02, "{}", g.value(&x));
+        }
+        assert!(pm.turns >= 1 && pm.turns <= MAX_TURNS);
+    }
+
+    #[test]
+    fn quaternion_convention_round_trips() {
+        for (a, b, c) in [(0.3, -1.2, 2.0), (3.0, 0.1, -0.5), (0.0, 0.0, 0.0)] {
+            let q = UnitQuaternion::from_euler_angles(a, b, c);
+            let m = lsdem_matrix(lsdem_quaternion(&q));
+            assert_relative_eq!(m, *q.to_rotation_matrix().matrix(), epsilon = 1e-14);
+            assert!(lsdem_quaternion(&q)[3] >= 0.0);
+        }
+    }
+
+    #[test]
+    fn positions_and_rotations_round_trip_exactly() {
+        let ps = vec![
+            Point3::new(1.0 / 3.0, -2e-7, 1e20),
+            Point3::new(0.0, 5.5, -1.25),
+        ];
+        let qs = vec![UnitQuaternion::from_euler_angles(0.1, 0.2, 0.3)];
+        let mut a = Vec::new();
+        write_positions(&mut a, &ps).expect("write");
+        let back = read_rows::<3>(a.as_slice(), "positions").expect("read");
+        for (p, r) in ps.iter().zip(&back) {
+            assert_eq!(p.coords.as_slice(), r.as_slice());
+        }
+        let mut b = Vec::new();
+        write_rotations(&mut b, &qs).expect("write");
+        let back = read_rows::<4>(b.as_slice(), "rotations").expect("read");
+        assert_eq!(back[0], lsdem_quaternion(&qs[0]));
+        assert!(write_positions(Vec::new(), &[Point3::new(f64::NAN, 0.0, 0.0)]).is_err());
+        assert!(read_rows::<3>("1 2\n".as_bytes(), "positions").is_err());
+        assert!(read_rows::<3>("1 2 x\n".as_bytes(), "positions").is_err());
+        assert!(read_rows::<3>("1 2 inf\n".as_bytes(), "positions").is_err());
+    }
+
+    #[test]
+    fn bad_parameters_are_errors() {
+        let (g, _, _) = tilted();
+        assert!(principal_morph(&g, 0.0, 1.0, 10).is_err());
+        assert!(principal_morph(&g, f64::NAN, 1.0, 10).is_err());
+        assert!(principal_morph(&g, 0.05, -1.0, 10).is_err());
+    }
+
+    #[test]
+    fn layout_names() {
+        assert_eq!(morph_path(1), "Morphologies/morph_1.dat");
+        assert_eq!(positions_path("sand"), "InitState/positions_sand.dat");
+        assert_eq!(rotations_path("sand"), "InitState/rotations_sand.dat");
+    }
+}
