@@ -184,6 +184,19 @@ pub enum Error {
         /// The largest fraction attempted.
         limit: f64,
     },
+    /// Trimming the clumps of a packing would take most of a sphere away (the packing is
+    /// tighter than a clump of so few spheres can follow).
+    #[error(
+        "clump of shape {shape}: a sphere of radius {radius} would lose {percent:.0} % of it to its neighbours; use more spheres per clump"
+    )]
+    ClumpTrimTooDeep {
+        /// The shape (template) index.
+        shape: usize,
+        /// The sphere's radius.
+        radius: f64,
+        /// The radius it would lose, in percent.
+        percent: f64,
+    },
     /// Overlap removal did not finish within the allowed sweeps.
     #[error(
         "overlaps remain after {sweeps} sweeps ({overlapping_pairs} pairs at grain scale {scale})"

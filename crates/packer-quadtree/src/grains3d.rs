@@ -214,6 +214,33 @@ impl StarGrain {
     pub fn table_radii(&self) -> Vec<f64> {
         self.table.radii()
     }
+
+    /// The grain's level set in its body frame: the star table rasterised
+    /// ([`levelset::Grid::from_star_table`], cube-map directions) on a cube
+    /// of `resolution` nodes per axis spanning `[−half_width, half_width]³`
+    /// — the level set that a specimen's outputs and checks are built from.
+    ///
+    /// # Errors
+    /// [`Error::StarTable`] for fewer than 3 nodes or a non-positive or
+    /// non-finite `half_width`.
+    pub fn level_set(&self, resolution: usize, half_width: f64) -> Result<levelset::Grid> {
+        let spec = levelset::GridSpec::cube(resolution, -half_width, half_width)
+            .map_err(Error::StarTable)?;
+        let params = levelset::StarParams {
+            table: levelset::DirectionTable::CubeMap {
+                face_cells: self.face_cells(),
+            },
+            ..levelset::StarParams::default()
+        };
+        let (grid, _) = levelset::Grid::from_star_table(
+            spec,
+            &nalgebra::Point3::origin(),
+            &self.table_radii(),
+            &params,
+        )
+        .map_err(Error::StarTable)?;
+        Ok(grid)
+    }
 }
 
 /// Parameters of [`pack_grains`] (plain data, validated at entry).

@@ -80,6 +80,7 @@
 // Seeded randomised tests print their seed (house style).
 #![cfg_attr(test, allow(clippy::print_stdout))]
 
+mod clump_trim;
 pub mod contact2d;
 pub mod contact3d;
 mod domain;
@@ -96,6 +97,7 @@ mod packer;
 mod pic;
 mod shapes;
 
+pub use clump_trim::{ClumpTrim, separate_clumps};
 pub use domain::Domain;
 pub use error::{Error, Result};
 pub use ga::{GaParams, GaResult, graded_layers, optimise_porosity};

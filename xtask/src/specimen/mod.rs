@@ -35,7 +35,7 @@ mod scene;
 #[cfg(test)]
 mod tests;
 
-use outputs::{LsdemPose, PlacedClump, Staging, Surfaces, VtuWriter};
+use outputs::{LsdemFrame, PlacedClump, Staging, Surfaces, VtuWriter};
 use scene::{Clones, ContainerSpec, ParentsSpec, Placement, Scene};
 
 /// Cube-map cells per face of the star tables the grain packer packs (and
@@ -242,8 +242,9 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     };
     let seed = scene.seed.unwrap_or(params.seed);
     params.seed = seed;
+    let provenance = provenance_lines(scene, &scene.source_text, root, seed);
     let model = CloneModel::fit(parents, &params)?;
-    let count = scene.clones.count();
+    let count = scene.distinct();
     let pb = crate::progress::bar("cloning", count, quiet);
     let cb = crate::progress::clone_callback(&pb);
     let clock = Clock(Instant::now());
@@ -259,8 +260,17 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         "clone",
         t,
         format!(
-            "{} clones of `{}` ({} candidates, acceptance {:.1} %); level sets kept: no, DNA measured: {}",
+            "{} clones of `{}`{} ({} candidates, acceptance {:.1} %); level sets kept: no, DNA measured: {}",
             run.clones.len(),
+            if scene.distinct_shapes.is_some() {
+                format!(
+                    " as the distinct shapes of {} grains (grain k a copy of clone k mod {})",
+                    scene.clones.count(),
+                    run.clones.len()
+                )
+            } else {
+                String::new()
+            },
             cal.name,
             run.stats.attempts,
             100.0 * run.stats.acceptance_rate(),
@@ -285,25 +295,26 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 .collect()
         }
     };
-    let bounding: Vec<f64> = run
-        .clones
-        .iter()
-        .zip(&scales)
-        .map(|(c, s)| c.surface.r_max * s * place::BOUNDING_MARGIN)
+    // grain k is a copy of clone (template) k mod n
+    let n_templates = run.clones.len();
+    let n_grains = scene.clones.count() as usize;
+    let template_of = |k: usize| k % n_templates;
+    let bounding: Vec<f64> = (0..n_grains)
+        .map(|k| {
+            let t = template_of(k);
+            run.clones[t].surface.r_max * scales[t] * place::BOUNDING_MARGIN
+        })
         .collect();
-    let to_place: Vec<place::ToPlace> = run
-        .clones
-        .iter()
-        .zip(&bounding)
-        .map(|(c, b)| place::ToPlace {
-            index: c.index,
-            bounding_radius: *b,
+    let to_place: Vec<place::ToPlace> = (0..n_grains)
+        .map(|k| place::ToPlace {
+            index: k as u64,
+            bounding_radius: bounding[k],
         })
         .collect();
 
     // place
     let t = Instant::now();
-    let grains: Option<Vec<StarGrain>> = match scene.placement {
+    let shapes: Option<Vec<StarGrain>> = match scene.placement {
         Placement::Grains => Some(
             run.clones
                 .par_iter()
@@ -320,6 +331,9 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         ),
         Placement::BoundingSpheres => None,
     };
+    let grains: Option<Vec<StarGrain>> = shapes
+        .as_ref()
+        .map(|t| (0..n_grains).map(|k| t[template_of(k)].clone()).collect());
     let mut grain_stats = None;
     let (container, poses) = if let Some(grains) = &grains {
         let (fixed, auto) = match &scene.container {
@@ -425,11 +439,11 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             );
         }
         let sphere_fraction = packer_quadtree::solid_fraction(&container, &spheres)?;
-        let grain_volume: f64 = run
-            .clones
-            .iter()
-            .zip(&scales)
-            .map(|(c, s)| c.surface.volume * s.powi(3))
+        let grain_volume: f64 = (0..n_grains)
+            .map(|k| {
+                let t = template_of(k);
+                run.clones[t].surface.volume * scales[t].powi(3)
+            })
             .sum();
         st.ran(
             "check",
@@ -444,7 +458,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         );
     }
 
-    // level sets on demand, with the per-grain outputs
+    // level sets on demand, per distinct shape (template), with its outputs
     let need = |on: bool, what: &str| {
         if on {
             None
@@ -452,8 +466,11 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             Some(format!("no {what} asked"))
         }
     };
-    let mut lsdem_poses: Vec<LsdemPose> = Vec::new();
-    let mut clumps: Vec<PlacedClump> = Vec::new();
+    let metres = scene.metres();
+    let mut frames: Vec<Option<LsdemFrame>> = vec![None; n_templates];
+    let mut template_spheres: Vec<Vec<(Point3<f64>, f64)>> = vec![Vec::new(); n_templates];
+    let mut template_volume: Vec<f64> = vec![f64::NAN; n_templates];
+    let mut meshes: Vec<Option<levelset::TriMesh>> = Vec::new();
     let ns = [
         AtomicU64::new(0), // rasterise
         AtomicU64::new(0), // lsdem
@@ -462,6 +479,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     ];
     let mut shrunk = 0usize;
     let mut triangles = 0usize;
+    let reuse = n_templates < n_grains;
     if out.level_sets() {
         let t = Instant::now();
         let res = scene.level_set_resolution;
@@ -475,19 +493,18 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         } else {
             None
         };
-        let pb = crate::progress::bar("level sets", run.clones.len() as u64, quiet);
-        let items: Vec<usize> = (0..run.clones.len()).collect();
+        let pb = crate::progress::bar("level sets", n_templates as u64, quiet);
+        let items: Vec<usize> = (0..n_templates).collect();
         for chunk in items.chunks(CHUNK) {
             let results: Vec<GrainOut> = chunk
                 .par_iter()
                 .map(|&k| {
                     let c = &run.clones[k];
-                    let pose = poses[k];
                     let t0 = Instant::now();
                     let radii: Vec<f64> = c.radii.iter().map(|r| r * scales[k]).collect();
                     // Grains: the packed star surface itself (the level set the
                     // check passed); bounding spheres: the model's own table.
-                    let grid = match &grains {
+                    let grid = match &shapes {
                         Some(g) => star_grid(&g[k], &radii, params.grid_margin, res),
                         None => model.rasterise_at(&radii, res).map_err(Into::into),
                     }
@@ -496,24 +513,22 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                     ns[0].fetch_add((t1 - t0).as_nanos() as u64, Ordering::Relaxed);
                     let mut g = GrainOut::default();
                     if out.lsdem {
-                        let common = resample(&grid, lsdem_h)
-                            .with_context(|| format!("LS-DEM grid of clone {}", c.index))?;
-                        let m = levelset::io::MorphFile::from_grid(&common, 1.0, out.lsdem_nodes)
-                            .with_context(|| format!("LS-DEM morph of clone {}", c.index))?;
-                        let file = format!("grain-{:06}.dat", c.index);
-                        let path = staging.path(&format!("lsdem/{file}"))?;
+                        let pm =
+                            levelset::io::principal_morph(&grid, lsdem_h, 1.0, out.lsdem_nodes)
+                                .with_context(|| format!("LS-DEM morph of clone {}", c.index))?;
+                        let path = staging
+                            .path(&format!("lsdem/{}", levelset::io::lsdem::morph_path(k + 1)))?;
                         let f = std::fs::File::create(&path)
                             .with_context(|| format!("creating {}", path.display()))?;
-                        levelset::io::write_morph(BufWriter::new(f), &m)
+                        let mut w = BufWriter::new(f);
+                        levelset::io::write_morph(&mut w, &pm.morph)
                             .with_context(|| format!("writing {}", path.display()))?;
-                        let h = common.spacing();
-                        let com = common.origin() + m.centroid.coords * h;
-                        g.lsdem = Some(LsdemPose {
-                            index: c.index,
-                            file,
-                            centre: pose * com,
-                            pose,
-                            spacing: h,
+                        std::io::Write::flush(&mut w)
+                            .with_context(|| format!("writing {}", path.display()))?;
+                        g.lsdem = Some(LsdemFrame {
+                            frame: pm.frame,
+                            spacing: pm.spacing,
+                            off_diagonal: pm.off_diagonal,
                         });
                     }
                     let t2 = Instant::now();
@@ -522,11 +537,8 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                         let cl = levelset::clump(&grid, &clump_params)
                             .with_context(|| format!("clump of clone {}", c.index))?;
                         g.shrunk = cl.shrunk;
-                        g.clump = Some(PlacedClump {
-                            index: c.index,
-                            pose,
-                            spheres: cl.spheres,
-                        });
+                        g.volume = grid.volume();
+                        g.clump = Some(cl.spheres);
                     }
                     let t3 = Instant::now();
                     ns[2].fetch_add((t3 - t2).as_nanos() as u64, Ordering::Relaxed);
@@ -542,18 +554,24 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             let t4 = Instant::now();
             let mut piece = Surfaces::default();
             for (&k, g) in chunk.iter().zip(results) {
-                if let Some(p) = g.lsdem {
-                    lsdem_poses.push(p);
-                }
+                frames[k] = g.lsdem;
                 if let Some(c) = g.clump {
-                    clumps.push(c);
+                    template_spheres[k] = c;
+                    template_volume[k] = g.volume;
                 }
                 shrunk += g.shrunk;
                 if let Some(m) = g.mesh {
-                    piece.push(run.clones[k].index, &m, &poses[k]);
+                    if reuse {
+                        meshes.resize_with(n_templates, || None);
+                        meshes[k] = Some(m);
+                    } else {
+                        piece.push(k as u64, &m, &poses[k], metres);
+                    }
                 }
             }
-            if let Some(w) = vtu.as_mut() {
+            if let Some(w) = vtu.as_mut()
+                && !reuse
+            {
                 triangles += piece.triangles.len();
                 w.piece(&piece).context("writing specimen.vtu")?;
             }
@@ -561,9 +579,24 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             pb.inc(chunk.len() as u64);
         }
         pb.finish_and_clear();
-        if let Some(w) = vtu {
+        if let Some(mut w) = vtu {
+            let t4 = Instant::now();
+            if reuse {
+                // every grain a copy of its template's surface, CHUNK grains per piece
+                for grains_chunk in (0..n_grains).collect::<Vec<_>>().chunks(CHUNK) {
+                    let mut piece = Surfaces::default();
+                    for &k in grains_chunk {
+                        if let Some(m) = &meshes[template_of(k)] {
+                            piece.push(k as u64, m, &poses[k], metres);
+                        }
+                    }
+                    triangles += piece.triangles.len();
+                    w.piece(&piece).context("writing specimen.vtu")?;
+                }
+            }
             let mut w = w.finish().context("writing specimen.vtu")?;
             std::io::Write::flush(&mut w).context("writing specimen.vtu")?;
+            ns[3].fetch_add(t4.elapsed().as_nanos() as u64, Ordering::Relaxed);
         }
         let wall = t.elapsed().as_secs_f64();
         let cpu = |k: usize| ns[k].load(Ordering::Relaxed) as f64 * 1e-9;
@@ -571,8 +604,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             "level sets",
             wall,
             format!(
-                "{} grids at {res}³ rasterised on the fly and dropped (for: {}); {:.3} s wall, {:.3} s CPU rasterising; per-output CPU below",
-                run.clones.len(),
+                "{n_templates} grids at {res}³ rasterised on the fly and dropped, one per distinct shape (for: {}); {:.3} s wall, {:.3} s CPU rasterising; per-output CPU below",
                 [
                     (out.lsdem, "LS-DEM"),
                     (out.clumps(), "clumps"),
@@ -597,48 +629,107 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         Some(r) => st.skip("lsdem", &r),
         None => {
             let t = Instant::now();
-            staging.write(
-                "lsdem/poses.txt",
-                outputs::lsdem_poses(&lsdem_poses).as_bytes(),
+            let files = outputs::lsdem_files(
+                &frames,
+                &poses,
+                &template_of,
+                metres,
+                &out.lsdem_name,
+                &provenance,
             )?;
-            staging.write(
-                "lsdem/positions.dat",
-                outputs::lsdem_positions(&lsdem_poses).as_bytes(),
-            )?;
-            staging.write(
-                "lsdem/rotations.dat",
-                outputs::lsdem_rotations(&lsdem_poses).as_bytes(),
-            )?;
-            staging.write(
-                "lsdem/morphID.dat",
-                outputs::lsdem_morph_ids(&lsdem_poses).as_bytes(),
-            )?;
+            for (name, bytes) in &files.text {
+                staging.write(&format!("lsdem/{name}"), bytes)?;
+            }
+            for (link, target) in &files.links {
+                staging.link(&format!("lsdem/{link}"), target)?;
+            }
             st.ran_s(
                 "lsdem",
                 cpu(1) + t.elapsed().as_secs_f64(),
                 format!(
-                    "{} morph files ({} surface nodes, one grid unit = {:.4}) + poses.txt, positions.dat, rotations.dat, morphID.dat (CPU)",
-                    lsdem_poses.len(),
+                    "{n_templates} morph files in their principal frames (worst |I_ij|/I_max {:.1e}; {} surface nodes, one grid unit = {:.4e} m){}, InitState/positions_{name}.dat, rotations_{name}.dat, poses.txt, PROVENANCE.txt (CPU)",
+                    files.worst_off_diagonal,
                     out.lsdem_nodes,
-                    lsdem_poses.first().map_or(f64::NAN, |p| p.spacing)
+                    files.spacing_m,
+                    if reuse {
+                        format!(
+                            ", {} more Morphologies/morph_<k>.dat as links to them",
+                            n_grains - n_templates
+                        )
+                    } else {
+                        String::new()
+                    },
+                    name = out.lsdem_name
                 ),
             );
         }
     }
-    // clumps (shared by the three clump outputs)
+    // clumps (shared by the three clump outputs): one clump per distinct shape, trimmed
+    // against every copy's neighbours, then the union's mass properties per shape
+    let mut clumps: Vec<PlacedClump> = Vec::new();
     match need(out.clumps(), "clump output") {
         Some(r) => st.skip("clumps", &r),
         None => {
-            let n: usize = clumps.iter().map(|c| c.spheres.len()).sum();
+            let n: usize = template_spheres.iter().map(Vec::len).sum();
             let t = Instant::now();
-            let tr = outputs::separate_clumps(&mut clumps, &container)?;
+            let tr = packer_quadtree::separate_clumps(
+                &mut template_spheres,
+                &poses,
+                template_of,
+                &container,
+            )?;
+            let unions: Vec<levelset::MassProperties> = template_spheres
+                .par_iter()
+                .zip(&template_volume)
+                .enumerate()
+                .map(|(k, (s, v))| {
+                    let d = (6.0 * v / std::f64::consts::PI).cbrt();
+                    levelset::union_mass_properties(s, d / UNION_CELLS)
+                        .with_context(|| format!("union of the clump of clone {k}"))
+                })
+                .collect::<anyhow::Result<_>>()?;
+            let k = n_templates.max(1) as f64;
+            let union_err = unions
+                .iter()
+                .zip(&template_volume)
+                .map(|(u, v)| (u.volume / v - 1.0).abs())
+                .sum::<f64>()
+                / k;
+            let sum_err = template_spheres
+                .iter()
+                .zip(&template_volume)
+                .map(|(s, v)| {
+                    s.iter()
+                        .map(|(_, r)| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
+                        .sum::<f64>()
+                        / v
+                        - 1.0
+                })
+                .sum::<f64>()
+                / k;
+            clumps = (0..n_grains)
+                .map(|g| {
+                    let tpl = template_of(g);
+                    PlacedClump {
+                        index: g as u64,
+                        template: tpl,
+                        pose: scale_pose(&poses[g], metres),
+                        spheres: template_spheres[tpl]
+                            .iter()
+                            .map(|(c, r)| (c * metres, r * metres))
+                            .collect(),
+                        volume: unions[tpl].volume * metres.powi(3),
+                        centroid: unions[tpl].centroid * metres,
+                        inertia: unions[tpl].inertia * metres.powi(5),
+                    }
+                })
+                .collect();
             st.ran_s(
                 "clumps",
                 cpu(2) + t.elapsed().as_secs_f64(),
                 format!(
-                    "{} clumps, {n} spheres ({:.1} per clump, at most {}){}; {} sphere pairs of different clumps overlapped (worst {:.2e} of the smaller diameter) and {} spheres crossed a wall: {} radii trimmed (at most {:.1} %), summed sphere volume {:+.2} % (CPU)",
-                    clumps.len(),
-                    n as f64 / clumps.len().max(1) as f64,
+                    "{n_templates} clumps for {n_grains} grains, {n} spheres ({:.1} per clump, at most {}){}; {} sphere pairs of different grains overlapped (worst {:.2e} of the smaller diameter) and {} spheres crossed a wall: {} radii trimmed (at most {:.1} %), summed sphere volume {:+.2} %; union volume vs level set: mean |error| {:.2} % (summed spheres: {:+.1} %, what a code that adds the spheres' masses would get) (CPU)",
+                    n as f64 / k,
                     out.clump.spheres_per_clump,
                     if shrunk > 0 {
                         format!(", {shrunk} candidate spheres shrunk")
@@ -650,16 +741,19 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                     tr.walls,
                     tr.trimmed,
                     100.0 * tr.max_cut,
-                    100.0 * tr.volume_change
+                    100.0 * tr.volume_change,
+                    100.0 * union_err,
+                    100.0 * sum_err,
                 ),
             );
         }
     }
+    let container_m = scale_container(&container, metres);
     match need(out.lammps_clumps, "LAMMPS clumps") {
         Some(r) => st.skip("lammps", &r),
         None => {
             let t = Instant::now();
-            let (data, body) = outputs::lammps_clumps(&clumps, &container, out.density)?;
+            let (data, body) = outputs::lammps_clumps(&clumps, &container_m, out.density)?;
             staging.write("lammps/clumps.data", &data)?;
             staging.write("lammps/clumps.body", body.as_bytes())?;
             staging.write("lammps/in.clumps", lammps_input().as_bytes())?;
@@ -701,8 +795,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             "vtu",
             cpu(3),
             format!(
-                "specimen.vtu: {triangles} marching-cubes triangles of {} grains at {} cells across, binary, grain_id per cell (CPU)",
-                run.clones.len(),
+                "specimen.vtu: {triangles} marching-cubes triangles of {n_grains} grains at {} cells across, binary, grain_id per cell, metres (CPU)",
                 out.vtu_resolution.min(scene.level_set_resolution - 1)
             ),
         ),
@@ -731,16 +824,28 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     }
     // always: poses and the stage report
     let t = Instant::now();
-    let indices: Vec<u64> = run.clones.iter().map(|c| c.index).collect();
+    let rows: Vec<outputs::PoseRow> = (0..n_grains)
+        .map(|k| outputs::PoseRow {
+            grain: k as u64,
+            clone: run.clones[template_of(k)].index,
+            pose: scale_pose(&poses[k], metres),
+            bounding_radius: bounding[k] * metres,
+            scale: scales[template_of(k)],
+        })
+        .collect();
     staging.write(
         "poses.csv",
-        outputs::poses_csv(&indices, &poses, &bounding, &scales).as_bytes(),
+        outputs::poses_csv(&rows, &provenance).as_bytes(),
+    )?;
+    staging.write(
+        "PROVENANCE.txt",
+        provenance_text(&provenance, scene).as_bytes(),
     )?;
     let out_dir = root.join(&scene.out_dir);
     st.ran(
         "write",
         t,
-        "poses.csv, report.txt; staged files moved into out_dir".into(),
+        "poses.csv (metres), PROVENANCE.txt, report.txt; staged files moved into out_dir".into(),
     );
     let mut report = StageReport {
         stages: st.0,
@@ -751,6 +856,109 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     staging.write("report.txt", report.text().as_bytes())?;
     report.files = staging.commit(&out_dir)?;
     Ok(report)
+}
+
+/// Lattice cells per equivalent diameter of the union integration of a clump
+/// (`levelset::union_mass_properties`): a clump's smallest spheres (≈ d/10) get ≈ 10
+/// cells per radius.
+const UNION_CELLS: f64 = 100.0;
+
+/// `pose` with its translation in metres (`metres` per scene unit).
+fn scale_pose(pose: &Isometry3<f64>, metres: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        nalgebra::Translation3::from(pose.translation.vector * metres),
+        pose.rotation,
+    )
+}
+
+/// `container` with its lengths in metres.
+fn scale_container(container: &Container, metres: f64) -> Container {
+    match container {
+        Container::Box { min, max, periodic } => Container::Box {
+            min: min * metres,
+            max: max * metres,
+            periodic: *periodic,
+        },
+        Container::Cylinder {
+            base,
+            radius,
+            height,
+        } => Container::Cylinder {
+            base: base * metres,
+            radius: radius * metres,
+            height: height * metres,
+        },
+        other => other.clone(),
+    }
+}
+
+/// The provenance lines of every output: grainforge version and commit, seed, the scene,
+/// and for clones of the embedded NIST/VCCTL grains their licence and citation.
+fn provenance_lines(scene: &Scene, scene_text: &str, root: &Path, seed: u64) -> Vec<String> {
+    let commit = std::process::Command::new("git")
+        .args(["rev-parse", "--short=12", "HEAD"])
+        .current_dir(root)
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned())
+        .unwrap_or_else(|| "unknown".into());
+    let dirty = std::process::Command::new("git")
+        .args(["status", "--porcelain", "--untracked-files=no"])
+        .current_dir(root)
+        .output()
+        .ok()
+        .is_some_and(|o| o.status.success() && !o.stdout.is_empty());
+    let mut lines = vec![
+        format!(
+            "grainforge {} (commit {commit}{}), cargo xtask specimen",
+            env!("CARGO_PKG_VERSION"),
+            if dirty {
+                ", with uncommitted changes"
+            } else {
+                ""
+            }
+        ),
+        format!(
+            "seed {seed}; units: SI (lengths m, masses kg, density {} kg/m^3); 1 parents' length unit = {:e} m",
+            scene.outputs.density,
+            scene.metres()
+        ),
+    ];
+    match &scene.parents {
+        ParentsSpec::Ottawa => lines.extend(
+            [
+                "parents: 71 Ottawa-sand grains of the NIST/VCCTL aggregate shape database (X-ray CT, spherical harmonics),",
+                "  Garboczi (2002), Cem. Concr. Res. 32:1621; VCCTL (Bentz, Garboczi, Bullard; github.com/jwbullard/VCCTL),",
+                "  Copyright (c) 2020-present Jeffrey W. Bullard, MIT licence (notice in full in PROVENANCE.txt).",
+                "  The clones are new grains statistically like these parents (grainforge GSC 2.0), not copies.",
+            ]
+            .iter()
+            .map(|s| (*s).to_owned()),
+        ),
+        ParentsSpec::Files { path, .. } => lines.push(format!("parents: {}", path.display())),
+    }
+    lines.push("scene:".into());
+    lines.extend(scene_text.lines().map(|l| format!("  {l}")));
+    lines
+}
+
+/// The licence notice of the embedded NIST/VCCTL grains.
+const VCCTL_NOTICE: &str = include_str!("../../../fixtures/grains/vcctl/NOTICE.txt");
+
+/// `PROVENANCE.txt`: the provenance lines, and the VCCTL licence notice in full when the
+/// parents are the embedded grains.
+fn provenance_text(lines: &[String], scene: &Scene) -> String {
+    let mut s = String::new();
+    for l in lines {
+        s.push_str(l);
+        s.push('\n');
+    }
+    if matches!(scene.parents, ParentsSpec::Ottawa) {
+        s.push('\n');
+        s.push_str(VCCTL_NOTICE);
+    }
+    s
 }
 
 /// The embedded Ottawa parents, built once per process (the tests run
@@ -781,21 +989,6 @@ fn lsdem_spacing(scene: &Scene, run: &cloner::Run, scales: &[f64], margin: f64) 
     own.get(own.len() / 2).copied().unwrap_or(1.0)
 }
 
-/// `grid` resampled (trilinear) at spacing `h` over the same box, so that
-/// every morph file shares one grid unit.
-fn resample(grid: &levelset::Grid, h: f64) -> anyhow::Result<levelset::Grid> {
-    let lo = grid.origin();
-    let d = grid.dims();
-    let extent = (d[0].max(d[1]).max(d[2]) - 1) as f64 * grid.spacing();
-    let n = ((extent / h).ceil() as usize + 1).max(3);
-    let spec = levelset::GridSpec {
-        dims: [n, n, n],
-        origin: lo,
-        spacing: h,
-    };
-    Ok(levelset::Grid::from_fn(spec, |p| grid.value(p))?)
-}
-
 /// `grid` resampled (trilinear) over the same box at `cells` cells across
 /// its largest side, for the VTU surface only; `None` when the grid is
 /// already that coarse (no upsampling).
@@ -815,11 +1008,13 @@ fn coarsen(grid: &levelset::Grid, cells: usize) -> anyhow::Result<Option<levelse
     Ok(Some(levelset::Grid::from_fn(spec, |p| grid.value(p))?))
 }
 
-/// The per-grain products of the level-set stage.
+/// The products of the level-set stage for one distinct shape.
 #[derive(Default)]
 struct GrainOut {
-    lsdem: Option<LsdemPose>,
-    clump: Option<PlacedClump>,
+    lsdem: Option<LsdemFrame>,
+    clump: Option<Vec<(Point3<f64>, f64)>>,
+    /// The level set's volume (scene units) when a clump was made.
+    volume: f64,
     shrunk: usize,
     mesh: Option<levelset::TriMesh>,
 }
@@ -887,16 +1082,7 @@ fn star_grid(
     resolution: usize,
 ) -> anyhow::Result<levelset::Grid> {
     let half = margin * radii.iter().fold(grain.r_max(), |a, b| a.max(*b));
-    let spec = levelset::GridSpec::cube(resolution, -half, half)?;
-    let params = levelset::StarParams {
-        table: levelset::DirectionTable::CubeMap {
-            face_cells: grain.face_cells(),
-        },
-        ..levelset::StarParams::default()
-    };
-    let (grid, _) =
-        levelset::Grid::from_star_table(spec, &Point3::origin(), &grain.table_radii(), &params)?;
-    Ok(grid)
+    Ok(grain.level_set(resolution, half)?)
 }
 
 /// The container of a fixed-size scene container.

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use nalgebra::{Isometry3, Point3};
 use packer_quadtree::{Container, Sphere};
 
@@ -68,6 +68,13 @@ impl Staging {
         std::fs::write(&p, bytes).with_context(|| format!("writing {}", p.display()))
     }
 
+    /// Stages a relative symbolic link `rel → target` (`target` relative to `rel`'s folder).
+    pub(crate) fn link(&self, rel: &str, target: &str) -> anyhow::Result<()> {
+        let p = self.path(rel)?;
+        std::os::unix::fs::symlink(target, &p)
+            .with_context(|| format!("linking {} to {target}", p.display()))
+    }
+
     /// Moves every staged file into `out_dir` (renames within one file
     /// system; a staged folder such as `lsdem/` replaces the one already
     /// there) and returns their paths relative to `out_dir`, sorted.
@@ -112,115 +119,140 @@ impl Drop for Staging {
     }
 }
 
-/// One placed grain's LS-DEM pose: the morph file it uses, its centre of
-/// mass in the world, its rotation and the length of one grid unit.
-pub(crate) struct LsdemPose {
-    pub(crate) index: u64,
-    pub(crate) file: String,
-    pub(crate) centre: Point3<f64>,
-    pub(crate) pose: Isometry3<f64>,
+/// Where a distinct shape's principal-frame morph file sits in its clone frame.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LsdemFrame {
+    /// Morph frame → clone frame (scene units; translation = centre of mass).
+    pub(crate) frame: Isometry3<f64>,
+    /// Scene length of one morph grid unit.
     pub(crate) spacing: f64,
+    /// Largest `|I_ij| / I_max` of the morph file's level set.
+    pub(crate) off_diagonal: f64,
 }
 
-/// `lsdem/poses.txt`: one line per grain.
-pub(crate) fn lsdem_poses(poses: &[LsdemPose]) -> String {
-    let mut s = String::from(
-        "# grainforge specimen: LS-DEM poses, one line per grain\n\
-         # id morph_file x y z q0 q1 q2 q3 spacing\n\
-         # x y z: the grain's centre of mass in the world (scene length unit);\n\
-         # q0 q1 q2 q3: unit quaternion (scalar first) rotating the morph file's axes to the world;\n\
-         # spacing: world length of one grid unit (the same for every morph file: they use spacing 1),\n\
-         # so a morph point p (relative to the centre of mass, grid units) is at x + R(q) * spacing * p.\n\
-         # positions.dat holds x y z / spacing (grid units), one grain per line, morphID.dat the file numbers,\n\
-         # rotations.dat the same rotations in LS-DEM's own quaternion convention (q0 q1 q2 q3 = y -x -z w).\n",
-    );
-    for p in poses {
-        let q = p.pose.rotation.quaternion();
+/// The LS-DEM files beside the morph files: text files and links (relative to `lsdem/`).
+pub(crate) struct LsdemFiles {
+    pub(crate) text: Vec<(String, Vec<u8>)>,
+    /// `Morphologies/morph_<k>.dat` → `morph_<t>.dat` for grains that reuse a shape.
+    pub(crate) links: Vec<(String, String)>,
+    pub(crate) worst_off_diagonal: f64,
+    /// Metres per grid unit.
+    pub(crate) spacing_m: f64,
+}
+
+/// The LS-DEM layout (`levelset::io::lsdem`): `InitState/positions_<NAME>.dat` (centres of
+/// mass in grid units), `InitState/rotations_<NAME>.dat` (LS-DEM's quaternion convention),
+/// links for reused morphs, `poses.txt` (SI) and `PROVENANCE.txt`.
+///
+/// Grain `k` (line `k + 1`) is a copy of shape `template_of(k)`; its morph frame → world
+/// is `poses[k] · frames[t].frame`.
+pub(crate) fn lsdem_files(
+    frames: &[Option<LsdemFrame>],
+    poses: &[Isometry3<f64>],
+    template_of: &dyn Fn(usize) -> usize,
+    metres: f64,
+    name: &str,
+    provenance: &[String],
+) -> anyhow::Result<LsdemFiles> {
+    use levelset::io::lsdem;
+    let mut grains = Vec::with_capacity(poses.len());
+    let mut worst = 0.0f64;
+    let mut h = f64::NAN;
+    let mut table = String::new();
+    for (k, pose) in poses.iter().enumerate() {
+        let t = template_of(k);
+        let f = frames
+            .get(t)
+            .copied()
+            .flatten()
+            .ok_or_else(|| anyhow::anyhow!("no morph file for shape {t}"))?;
+        h = f.spacing;
+        worst = worst.max(f.off_diagonal);
+        let world = pose * f.frame;
+        // LS-DEM works in grid units: the morph frame → world in grid units
+        grains.push((
+            t,
+            Isometry3::from_parts(
+                nalgebra::Translation3::from(world.translation.vector / f.spacing),
+                world.rotation,
+            ),
+        ));
+        let q = world.rotation.quaternion();
+        let c = world.translation.vector * metres;
         let _ = writeln!(
-            s,
+            table,
             "{} {} {:e} {:e} {:e} {:e} {:e} {:e} {:e} {:e}",
-            p.index, p.file, p.centre.x, p.centre.y, p.centre.z, q.w, q.i, q.j, q.k, p.spacing
+            k + 1,
+            lsdem::morph_path(t + 1),
+            c.x,
+            c.y,
+            c.z,
+            q.w,
+            q.i,
+            q.j,
+            q.k,
+            f.spacing * metres
         );
     }
-    s
-}
-
-/// `lsdem/positions.dat`: `x y z` of every centre of mass in grid units
-/// (world / spacing), one grain per line, no header (what LS-DEM codes read
-/// with their position-file readers).
-pub(crate) fn lsdem_positions(poses: &[LsdemPose]) -> String {
-    let mut s = String::new();
-    for p in poses {
-        let c = p.centre.coords / p.spacing;
-        let _ = writeln!(s, "{:e} {:e} {:e}", c.x, c.y, c.z);
+    let mut text = Vec::new();
+    let mut links = Vec::new();
+    for e in lsdem::layout(name, &grains)? {
+        match e {
+            lsdem::LayoutEntry::File { path, bytes } => text.push((path, bytes)),
+            lsdem::LayoutEntry::Link { path, target } => links.push((path, target)),
+        }
     }
-    s
-}
-
-/// The LS-DEM quaternion `[q0, q1, q2, q3]` of a body → world rotation.
-///
-/// LS-DEM (Kawamoto et al. 2016, 2018; `Grain3d::updateRotationMatrix` of
-/// the Kawamoto/Andrade code and its descendants) stores `(X, Y, Z, W)` but
-/// builds its rotation matrix with a sign and axis convention of its own:
-/// for a Hamilton unit quaternion `w + x i + y j + z k` whose matrix is the
-/// body → world rotation `R` (world point = `R · morph point + position`,
-/// the convention of its `_pointList = _rotMatrix * _refPointList +
-/// _position`), LS-DEM's matrix equals `R` when the file holds
-/// `q0 = y, q1 = −x, q2 = −z, q3 = w`. `lsdem_matrix` is that matrix,
-/// written out as LS-DEM does; the tests check the round trip.
-pub(crate) fn lsdem_quaternion(rotation: &nalgebra::UnitQuaternion<f64>) -> [f64; 4] {
-    let q = rotation.quaternion();
-    // one sign for q and −q (the same rotation): W ≥ 0
-    let s = if q.w < 0.0 { -1.0 } else { 1.0 };
-    [s * q.j, -s * q.i, -s * q.k, s * q.w]
-}
-
-/// LS-DEM's rotation matrix of a file quaternion `[q0, q1, q2, q3]`
-/// (`Grain3d::updateRotationMatrix`, term by term): the body → world
-/// rotation the simulation will apply.
-#[cfg(test)]
-pub(crate) fn lsdem_matrix(q: [f64; 4]) -> nalgebra::Matrix3<f64> {
-    let [a, b, c, d] = q;
-    nalgebra::Matrix3::new(
-        -a * a + b * b - c * c + d * d,
-        -2.0 * (a * b - c * d),
-        2.0 * (b * c + a * d),
-        -2.0 * (a * b + c * d),
-        a * a - b * b - c * c + d * d,
-        -2.0 * (a * c - b * d),
-        2.0 * (b * c - a * d),
-        -2.0 * (a * c + b * d),
-        -a * a - b * b + c * c + d * d,
-    )
-}
-
-/// `lsdem/rotations.dat`: one LS-DEM quaternion `q0 q1 q2 q3` per line of
-/// `positions.dat` (single spaces, no header: LS-DEM's
-/// `readQuaternionFile`), see [`lsdem_quaternion`] for the convention.
-pub(crate) fn lsdem_rotations(poses: &[LsdemPose]) -> String {
-    let mut s = String::new();
-    for p in poses {
-        let [a, b, c, d] = lsdem_quaternion(&p.pose.rotation);
-        let _ = writeln!(s, "{a:e} {b:e} {c:e} {d:e}");
+    let mut header = String::new();
+    for l in provenance {
+        let _ = writeln!(header, "# {l}");
     }
-    s
-}
-
-/// `lsdem/morphID.dat`: the morph file number (`grain-NNNNNN.dat`) of every
-/// line of `positions.dat`.
-pub(crate) fn lsdem_morph_ids(poses: &[LsdemPose]) -> String {
-    let mut s = String::new();
-    for p in poses {
-        let _ = writeln!(s, "{}", p.index);
+    header.push_str(
+        "# LS-DEM poses, one line per grain (line k of InitState/positions_NAME.dat and rotations_NAME.dat)\n\
+         # k morph_file x y z q0 q1 q2 q3 grid_unit\n\
+         # x y z: the grain's centre of mass in the world, metres; q0..q3: unit quaternion (scalar first)\n\
+         # rotating the morph file's (principal) axes to the world; grid_unit: metres per morph grid unit.\n\
+         # A morph point p (grid units, relative to the centre of mass) is at x + R(q) * grid_unit * p.\n\
+         # The morph files are in grid units (spacing 1) with density 1: mass in kg = density * grid_unit^3 * morph mass,\n\
+         # moments in kg m^2 = density * grid_unit^5 * morph moments. positions_NAME.dat is x y z / grid_unit,\n\
+         # rotations_NAME.dat the same rotations in LS-DEM's convention (q0 q1 q2 q3 = y -x -z w of the quaternion above).\n",
+    );
+    header.push_str(&table);
+    let mut prov = String::new();
+    for l in provenance {
+        prov.push_str(l);
+        prov.push('\n');
     }
-    s
+    let _ = writeln!(
+        prov,
+        "LS-DEM input folder: Morphologies/morph_<k>.dat for line k of InitState/positions_{name}.dat and rotations_{name}.dat; \
+         lengths in grid units, 1 grid unit = {:e} m; morph files in their principal-axis frames.",
+        h * metres
+    );
+    text.push(("poses.txt".into(), header.into_bytes()));
+    text.push(("PROVENANCE.txt".into(), prov.into_bytes()));
+    Ok(LsdemFiles {
+        text,
+        links,
+        worst_off_diagonal: worst,
+        spacing_m: h * metres,
+    })
 }
 
-/// A clump of one placed grain: its spheres in the clone frame (scaled).
+/// The clump of one placed grain, in metres: its spheres in the clone frame, the union's
+/// volume, centroid and inertia (per unit density, clone frame) of its shape.
 pub(crate) struct PlacedClump {
     pub(crate) index: u64,
+    /// The distinct shape it copies.
+    #[allow(dead_code)]
+    pub(crate) template: usize,
     pub(crate) pose: Isometry3<f64>,
     pub(crate) spheres: Vec<(Point3<f64>, f64)>,
+    #[allow(dead_code)]
+    pub(crate) volume: f64,
+    #[allow(dead_code)]
+    pub(crate) centroid: Point3<f64>,
+    #[allow(dead_code)]
+    pub(crate) inertia: nalgebra::Matrix3<f64>,
 }
 
 impl PlacedClump {
@@ -365,10 +397,17 @@ pub(crate) struct Surfaces {
 }
 
 impl Surfaces {
-    /// Appends a grain's mesh, moved by `pose`.
-    pub(crate) fn push(&mut self, id: u64, mesh: &levelset::TriMesh, pose: &Isometry3<f64>) {
+    /// Appends a grain's mesh, moved by `pose` and scaled by `metres` (scene unit → m).
+    pub(crate) fn push(
+        &mut self,
+        id: u64,
+        mesh: &levelset::TriMesh,
+        pose: &Isometry3<f64>,
+        metres: f64,
+    ) {
         let base = self.points.len();
-        self.points.extend(mesh.vertices().iter().map(|p| pose * p));
+        self.points
+            .extend(mesh.vertices().iter().map(|p| (pose * p) * metres));
         for t in mesh.triangles() {
             self.triangles.push([t[0] + base, t[1] + base, t[2] + base]);
             self.grain_ids.push(id);
@@ -645,141 +684,32 @@ pub(crate) fn read_vtu(text: &str) -> anyhow::Result<Vec<VtuPiece>> {
     Ok(pieces)
 }
 
-/// `poses.csv`: every placed grain's pose (always written).
-pub(crate) fn poses_csv(
-    indices: &[u64],
-    poses: &[Isometry3<f64>],
-    bounding: &[f64],
-    scales: &[f64],
-) -> String {
-    let mut s = String::from(
-        "# grainforge specimen: clone frame -> world. x,y,z: the clone frame's origin; q0..q3: unit quaternion (scalar first); bounding_radius: the placed bounding sphere; scale: factor applied to the clone's radii (1 unless the scene grades the sizes)\nid,x,y,z,q0,q1,q2,q3,bounding_radius,scale\n",
+/// One line of `poses.csv` (metres).
+pub(crate) struct PoseRow {
+    pub(crate) grain: u64,
+    pub(crate) clone: u64,
+    pub(crate) pose: Isometry3<f64>,
+    pub(crate) bounding_radius: f64,
+    pub(crate) scale: f64,
+}
+
+/// `poses.csv`: every placed grain's pose (always written), in metres.
+pub(crate) fn poses_csv(rows: &[PoseRow], provenance: &[String]) -> String {
+    let mut s = String::new();
+    for l in provenance {
+        let _ = writeln!(s, "# {l}");
+    }
+    s.push_str(
+        "# clone frame -> world, metres. grain: grain number; clone: the clone whose shape it has (grains share a clone when the scene sets distinct_shapes); x,y,z: the clone frame's origin (m); q0..q3: unit quaternion (scalar first); bounding_radius: of the grain about x,y,z (m); scale: factor applied to the clone's radii (1 unless the scene grades the sizes)\ngrain,clone,x,y,z,q0,q1,q2,q3,bounding_radius,scale\n",
     );
-    for (((i, p), b), sc) in indices.iter().zip(poses).zip(bounding).zip(scales) {
-        let q = p.rotation.quaternion();
-        let t = p.translation.vector;
+    for r in rows {
+        let q = r.pose.rotation.quaternion();
+        let t = r.pose.translation.vector;
         let _ = writeln!(
             s,
-            "{i},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-            t.x, t.y, t.z, q.w, q.i, q.j, q.k, b, sc
+            "{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            r.grain, r.clone, t.x, t.y, t.z, q.w, q.i, q.j, q.k, r.bounding_radius, r.scale
         );
     }
     s
-}
-
-/// Radius trimming of [`separate_clumps`].
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Trim {
-    /// Sphere pairs of different clumps that overlapped.
-    pub(crate) pairs: usize,
-    /// Worst of those overlaps over the smaller sphere's diameter.
-    pub(crate) worst: f64,
-    /// Spheres that crossed a wall.
-    pub(crate) walls: usize,
-    /// Spheres whose radius was trimmed.
-    pub(crate) trimmed: usize,
-    /// Largest relative radius reduction.
-    pub(crate) max_cut: f64,
-    /// Relative change of the summed sphere volumes.
-    pub(crate) volume_change: f64,
-}
-
-/// Makes the clumps of a grain packing a valid DEM start: the clumps
-/// approximate the level sets (their radii are offset to match each
-/// grain's volume), so their spheres may reach past a grain's surface,
-/// across the margin the packer leaves and into a neighbour's spheres or a
-/// wall. Every sphere of a pair of different clumps that overlaps by `δ`
-/// loses `δ/2` (plus 1e-9 of its radius) of radius — the largest cut any of
-/// its pairs asks, so one pass leaves no overlap — and a sphere crossing a
-/// wall is cut to its clearance. Spheres of one clump keep overlapping each
-/// other (they are one rigid body). A uniform cell grid of sphere centres
-/// (cell = the largest diameter): O(spheres).
-///
-/// # Errors
-/// A sphere that would lose more than 90 % of its radius (the packing is
-/// not one a clump of this size can follow).
-pub(crate) fn separate_clumps(
-    clumps: &mut [PlacedClump],
-    container: &Container,
-) -> anyhow::Result<Trim> {
-    let index: Vec<(usize, usize)> = clumps
-        .iter()
-        .enumerate()
-        .flat_map(|(k, c)| (0..c.spheres.len()).map(move |m| (k, m)))
-        .collect();
-    let spheres: Vec<(Point3<f64>, f64, usize)> = clumps
-        .iter()
-        .enumerate()
-        .flat_map(|(k, c)| c.world().map(move |s| (s.center, s.radius, k)))
-        .collect();
-    let mut trim = Trim::default();
-    let Some(r_max) = spheres.iter().map(|s| s.1).reduce(f64::max) else {
-        return Ok(trim);
-    };
-    let cell = 2.0 * r_max;
-    let key = |p: &Point3<f64>| {
-        [
-            (p.x / cell).floor() as i64,
-            (p.y / cell).floor() as i64,
-            (p.z / cell).floor() as i64,
-        ]
-    };
-    let mut grid: std::collections::BTreeMap<[i64; 3], Vec<usize>> =
-        std::collections::BTreeMap::new();
-    for (i, s) in spheres.iter().enumerate() {
-        grid.entry(key(&s.0)).or_default().push(i);
-    }
-    let mut cut = vec![0.0_f64; spheres.len()];
-    for (i, a) in spheres.iter().enumerate() {
-        let clear = container.clearance(&a.0);
-        if clear < a.1 {
-            trim.walls += 1;
-            cut[i] = cut[i].max(a.1 - clear + 1e-9 * a.1);
-        }
-        let k = key(&a.0);
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) else {
-                        continue;
-                    };
-                    for &j in list {
-                        let b = &spheres[j];
-                        if j <= i || b.2 == a.2 {
-                            continue;
-                        }
-                        let overlap = a.1 + b.1 - (a.0 - b.0).norm();
-                        if overlap > 0.0 {
-                            trim.pairs += 1;
-                            trim.worst = trim.worst.max(overlap / (2.0 * a.1.min(b.1)));
-                            cut[i] = cut[i].max(0.5 * overlap + 1e-9 * a.1);
-                            cut[j] = cut[j].max(0.5 * overlap + 1e-9 * b.1);
-                        }
-                    }
-                }
-            }
-        }
-    }
-    let (mut before, mut after) = (0.0, 0.0);
-    for (i, &(k, m)) in index.iter().enumerate() {
-        let r = &mut clumps[k].spheres[m].1;
-        before += r.powi(3);
-        if cut[i] > 0.0 {
-            let rel = cut[i] / *r;
-            if rel > 0.9 {
-                bail!(
-                    "clump of clone {}: a sphere of radius {:.4} would lose {:.0} % of it to its neighbours; use more spheres per clump",
-                    clumps[k].index,
-                    *r,
-                    100.0 * rel
-                );
-            }
-            trim.trimmed += 1;
-            trim.max_cut = trim.max_cut.max(rel);
-            *r -= cut[i];
-        }
-        after += r.powi(3);
-    }
-    trim.volume_change = after / before - 1.0;
-    Ok(trim)
 }

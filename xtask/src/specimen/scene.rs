@@ -15,7 +15,9 @@
 //!     clones: Count(200),          // or Graded(count: 200, grading: "uniform:200,400"):
 //!                                  // each clone rescaled to a volume-equivalent diameter
 //!                                  // drawn from the grading (by number; `cargo xtask pack` syntax)
+//!     distinct_shapes: None,       // Some(1000): 1000 clones, grain k a copy of clone k mod 1000
 //!     seed: None,                  // default: the calibrated seed
+//!     length_unit: None,           // metres per parents' unit (Ottawa: 1e-6; required for Files)
 //!     container: AutoCylinder(solid_fraction: 0.5),
 //!                                  // or Cylinder(diameter: 3000.0, height: None) (H = 2 D),
 //!                                  // or Box(x: 2500.0, y: 2500.0, z: 2500.0); lengths in the parents' unit
@@ -32,7 +34,8 @@
 //!         liggghts_templates: false, // LIGGGHTS particletemplate/multisphere files
 //!         yade_clumps: false,      // Yade clump list + loader script
 //!         clump: (spheres_per_clump: 20, overlap: 0.6),
-//!         density: 1.0,            // mass per volume written to the LAMMPS data file
+//!         density: 2650.0,         // particle density, kg/m³ (quartz)
+//!         lsdem_name: "specimen",  // InitState/positions_<NAME>.dat, rotations_<NAME>.dat
 //!         vtu: false,              // marching-cubes surfaces of every placed grain (ParaView)
 //!         vtu_resolution: 16,      // cells across each grain's level-set box for its VTU surface (≈ 44 KB per grain)
 //!         report: false,           // DNA and grading report with SVG plots
@@ -60,9 +63,21 @@ pub(crate) struct Scene {
     pub(crate) calibrated: Option<PathBuf>,
     /// How many clones, and their sizes.
     pub(crate) clones: Clones,
+    /// Distinct clone shapes (default: one per grain): with `Some(n)` only `n` clones are
+    /// made and grain `k` is a copy of clone `k mod n` (own pose, same size): LS-DEM's own
+    /// morph reuse, so that `n` morph files (the others are links) and `n` LIGGGHTS
+    /// templates serve any number of grains.
+    #[serde(default)]
+    pub(crate) distinct_shapes: Option<u64>,
     /// Master seed (default: the calibrated configuration's).
     #[serde(default)]
     pub(crate) seed: Option<u64>,
+    /// Metres per length unit of the parents (and of every length in this scene: the
+    /// container, the grading, `lsdem_spacing`). Default for the embedded Ottawa grains:
+    /// [`OTTAWA_LENGTH_UNIT`]; required for `Files` parents. Every output is written in
+    /// metres.
+    #[serde(default)]
+    pub(crate) length_unit: Option<f64>,
     /// The container.
     pub(crate) container: ContainerSpec,
     /// How the clones are placed.
@@ -81,7 +96,17 @@ pub(crate) struct Scene {
     /// Output folder.
     #[serde(default = "default_out_dir")]
     pub(crate) out_dir: PathBuf,
+    /// The scene file's text (for the provenance of every output).
+    #[serde(skip)]
+    pub(crate) source_text: String,
 }
+
+/// Metres per scan unit of the embedded NIST/VCCTL Ottawa-sand grains (see
+/// `fixtures/grains/vcctl/README.md`, "Units").
+pub(crate) const OTTAWA_LENGTH_UNIT: f64 = 1e-6;
+
+/// The default particle density, kg/m³ (quartz).
+pub(crate) const QUARTZ_DENSITY: f64 = 2650.0;
 
 fn default_resolution() -> usize {
     45
@@ -235,8 +260,10 @@ pub(crate) struct Outputs {
     pub(crate) yade_clumps: bool,
     /// Clump parameters shared by the three clump outputs.
     pub(crate) clump: ClumpSpec,
-    /// Mass per volume in the LAMMPS data file.
+    /// Particle density in kg/m³ (default 2650, quartz): every output's masses.
     pub(crate) density: f64,
+    /// LS-DEM test name: `InitState/positions_<NAME>.dat`, `rotations_<NAME>.dat`.
+    pub(crate) lsdem_name: String,
     /// VTU of the marching-cubes surfaces of every placed grain.
     pub(crate) vtu: bool,
     /// Cells across the widest side of each grain's level-set box for its
@@ -259,7 +286,8 @@ impl Default for Outputs {
             liggghts_templates: false,
             yade_clumps: false,
             clump: ClumpSpec::default(),
-            density: 1.0,
+            density: QUARTZ_DENSITY,
+            lsdem_name: "specimen".into(),
             vtu: false,
             vtu_resolution: 16,
             report: false,
@@ -309,10 +337,21 @@ impl ClumpSpec {
 }
 
 impl Scene {
+    /// Metres per scene length unit (validated: `Files` parents state it).
+    pub(crate) fn metres(&self) -> f64 {
+        self.length_unit.unwrap_or(OTTAWA_LENGTH_UNIT)
+    }
+
+    /// Distinct clone shapes to make.
+    pub(crate) fn distinct(&self) -> u64 {
+        self.distinct_shapes.unwrap_or(self.clones.count())
+    }
+
     /// Parses a scene; errors carry `line:column` and the offending key.
     pub(crate) fn parse(text: &str, source: &Path) -> anyhow::Result<Self> {
-        let scene: Self =
+        let mut scene: Self =
             ron::from_str(text).map_err(|e| anyhow::anyhow!("{}:{e}", source.display()))?;
+        scene.source_text = text.to_owned();
         scene.validate(source)?;
         Ok(scene)
     }
@@ -373,6 +412,38 @@ impl Scene {
             bail!("{at}: `outputs.lsdem_nodes` must be at least 1");
         }
         positive("outputs.density", self.outputs.density)?;
+        if let Some(l) = self.length_unit {
+            positive("length_unit", l)?;
+        }
+        if matches!(self.parents, ParentsSpec::Files { .. }) && self.length_unit.is_none() {
+            bail!(
+                "{at}: `length_unit` (metres per length unit of the parents, e.g. 1e-6 for micrometres) is required for `Files` parents: every output is written in metres"
+            );
+        }
+        if let Some(n) = self.distinct_shapes
+            && (n == 0 || n > self.clones.count())
+        {
+            bail!(
+                "{at}: `distinct_shapes` must be in 1..={} (the clone count), got {n}",
+                self.clones.count()
+            );
+        }
+        let name = &self.outputs.lsdem_name;
+        if name.is_empty()
+            || !name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        {
+            bail!(
+                "{at}: `outputs.lsdem_name` must be a non-empty file-name part of letters, digits, `_` and `-`, got {name:?}"
+            );
+        }
+        if self.outputs.clumps() && self.outputs.clump.spheres_per_clump < 2 {
+            bail!(
+                "{at}: `outputs.clump.spheres_per_clump` must be at least 2 for the clump outputs (LIGGGHTS refuses a one-sphere multisphere template; a one-sphere clump is a sphere: use `cargo xtask pack`), got {}",
+                self.outputs.clump.spheres_per_clump
+            );
+        }
         if !(4..=400).contains(&self.outputs.vtu_resolution) {
             bail!(
                 "{at}: `outputs.vtu_resolution` must be in 4..=400, got {}",

@@ -90,10 +90,18 @@ fn each_output_flag_changes_only_its_own_files() {
     let base_files = files_under(&base_dir);
     assert_eq!(
         base_files,
-        ["poses.csv", "report.txt"].map(String::from).into(),
+        ["PROVENANCE.txt", "poses.csv", "report.txt"]
+            .map(String::from)
+            .into(),
         "{base_files:?}"
     );
-    assert_eq!(base.files.len(), 2);
+    assert_eq!(base.files.len(), 3);
+    let prov = std::fs::read_to_string(base_dir.join("PROVENANCE.txt")).expect("provenance");
+    assert!(
+        prov.contains("grainforge")
+            && prov.contains("seed 3")
+            && prov.contains("clones: Count(20)")
+    );
     // flag → the files it must add (every other file unchanged)
     type Owns = fn(&str) -> bool;
     let cases: [(&str, Owns); 6] = [
@@ -127,12 +135,12 @@ fn each_output_flag_changes_only_its_own_files() {
     assert_eq!(
         lsdem
             .iter()
-            .filter(|f| f.starts_with("lsdem/grain-"))
+            .filter(|f| f.starts_with("lsdem/Morphologies/morph_"))
             .count(),
         20,
         "one morph file per grain"
     );
-    // one grid unit for every morph file; positions in that unit
+    // one grid unit for every morph file
     let poses = std::fs::read_to_string(dir.join("flag-0/lsdem/poses.txt")).expect("poses");
     let spacings: BTreeSet<String> = poses
         .lines()
@@ -140,14 +148,6 @@ fn each_output_flag_changes_only_its_own_files() {
         .filter_map(|l| l.split_whitespace().last().map(String::from))
         .collect();
     assert_eq!(spacings.len(), 1, "{spacings:?}");
-    let positions =
-        std::fs::read_to_string(dir.join("flag-0/lsdem/positions.dat")).expect("positions");
-    assert_eq!(positions.lines().count(), 20);
-    let morph = levelset::io::read_morph(std::io::BufReader::new(
-        std::fs::File::open(dir.join("flag-0/lsdem/grain-000000.dat")).expect("morph"),
-    ))
-    .expect("the morph file reads back");
-    assert!(morph.mass > 0.0 && morph.points.len() == 1000);
     let body = std::fs::read_to_string(dir.join("flag-1/lammps/clumps.body")).expect("body");
     let data = packer_quadtree::read_lammps_data3(std::io::BufReader::new(
         std::fs::File::open(dir.join("flag-1/lammps/clumps.data")).expect("data"),
@@ -163,7 +163,7 @@ fn each_output_flag_changes_only_its_own_files() {
     assert!(vtu.contains("grain_id") && vtu.trim_end().ends_with("</VTKFile>"));
     assert!(vtu.contains(r#"header_type="UInt64""#) && !vtu.contains(r#"format="ascii""#));
     vtu_reads_back(&vtu, 20);
-    lsdem_rotations_round_trip(&dir.join("flag-0"), &base_poses);
+    lsdem_folder_reads_as_lsdem(&dir.join("flag-0/lsdem"), 20);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -368,58 +368,67 @@ fn vtu_reads_back(vtu: &str, grains: usize) {
     assert_eq!(ids.len(), grains, "one surface per grain: {ids:?}");
 }
 
-/// `lsdem/rotations.dat`, turned into matrices as LS-DEM does, are the
-/// rotations of `poses.csv`, and `positions.dat · spacing` are the centres
-/// of mass of `poses.txt`.
-fn lsdem_rotations_round_trip(dir: &Path, poses_csv: &str) {
-    let nums = |l: &str| -> Vec<f64> {
-        l.split([' ', ','])
-            .filter_map(|x| x.parse::<f64>().ok())
-            .collect()
+/// The LS-DEM folder as LS-DEM reads it: `Morphologies/morph_<k>.dat` for every line `k` of
+/// `InitState/positions_specimen.dat` and `rotations_specimen.dat`, each morph file's level
+/// set principal (|I_ij| ≤ 1e-9 I_max by its own inertia), and LS-DEM's pose of each line
+/// (position × grid unit, its rotation matrix) equal to `poses.txt`'s (metres).
+fn lsdem_folder_reads_as_lsdem(dir: &Path, grains: usize) {
+    use levelset::io::lsdem;
+    let open = |rel: &str| {
+        std::io::BufReader::new(
+            std::fs::File::open(dir.join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}")),
+        )
     };
-    let rotations = std::fs::read_to_string(dir.join("lsdem/rotations.dat")).expect("rotations");
-    let ids = std::fs::read_to_string(dir.join("lsdem/morphID.dat")).expect("morph ids");
-    let positions = std::fs::read_to_string(dir.join("lsdem/positions.dat")).expect("positions");
-    let poses_txt = std::fs::read_to_string(dir.join("lsdem/poses.txt")).expect("poses.txt");
-    let poses: Vec<Vec<f64>> = poses_csv
-        .lines()
-        .filter(|l| l.chars().next().is_some_and(|c| c.is_ascii_digit()))
-        .map(nums)
-        .collect();
-    let txt: Vec<Vec<f64>> = poses_txt
+    let pos = lsdem::read_rows::<3>(open(&lsdem::positions_path("specimen")), "positions")
+        .expect("positions");
+    let rot = lsdem::read_rows::<4>(open(&lsdem::rotations_path("specimen")), "rotations")
+        .expect("rotations");
+    assert_eq!(pos.len(), grains);
+    assert_eq!(rot.len(), grains);
+    let txt = std::fs::read_to_string(dir.join("poses.txt")).expect("poses.txt");
+    let rows: Vec<Vec<f64>> = txt
         .lines()
         .filter(|l| !l.starts_with('#'))
-        .map(|l| nums(&l.split_whitespace().skip(2).collect::<Vec<_>>().join(" ")))
+        .map(|l| {
+            l.split_whitespace()
+                .skip(2)
+                .map(|x| x.parse().expect("number"))
+                .collect()
+        })
         .collect();
-    assert_eq!(rotations.lines().count(), poses.len());
-    for (((line, id), pos), t) in rotations
-        .lines()
-        .zip(ids.lines())
-        .zip(positions.lines())
-        .zip(&txt)
-    {
-        // LS-DEM's reader: single spaces, four numbers
-        let q: Vec<f64> = line
-            .split(' ')
-            .map(|x| x.parse().expect("number"))
-            .collect();
-        let q: [f64; 4] = q.try_into().expect("four numbers per line");
+    assert_eq!(rows.len(), grains);
+    for k in 0..grains {
+        let m = levelset::io::read_morph(open(&lsdem::morph_path(k + 1))).expect("morph");
+        assert!(m.mass > 0.0 && m.points.len() == 1000);
+        let mp = m.grid.mass_properties().expect("mass");
+        assert!(
+            lsdem::off_diagonal(&mp.inertia) <= 1e-9,
+            "morph {}: {:e}",
+            k + 1,
+            lsdem::off_diagonal(&mp.inertia)
+        );
+        // moments in the file = the diagonal of the level set's inertia (unit density)
+        for a in 0..3 {
+            approx::assert_relative_eq!(
+                m.principal_moments[a],
+                mp.inertia[(a, a)],
+                max_relative = 1e-9
+            );
+        }
+        let q = rot[k];
         approx::assert_relative_eq!(q.iter().map(|v| v * v).sum::<f64>(), 1.0, epsilon = 1e-12);
-        let id: usize = id.trim().parse().expect("morph id");
-        let row = poses
-            .iter()
-            .find(|r| r[0] as usize == id)
-            .expect("pose of the grain");
+        let r = &rows[k];
+        let h = r[7];
         let world = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
-            row[4], row[5], row[6], row[7],
+            r[3], r[4], r[5], r[6],
         ));
-        let r = super::outputs::lsdem_matrix(q);
-        approx::assert_relative_eq!(r, *world.to_rotation_matrix().matrix(), epsilon = 1e-12);
-        // positions in grid units: × spacing = the centre of mass of poses.txt
-        let p = nums(pos);
-        let h = t[7];
-        for k in 0..3 {
-            approx::assert_relative_eq!(p[k] * h, t[k], max_relative = 1e-12);
+        approx::assert_relative_eq!(
+            lsdem::lsdem_matrix(q),
+            *world.to_rotation_matrix().matrix(),
+            epsilon = 1e-12
+        );
+        for a in 0..3 {
+            approx::assert_relative_eq!(pos[k][a] * h, r[a], max_relative = 1e-12);
         }
     }
 }
@@ -446,9 +455,9 @@ fn lsdem_quaternions_give_lsdem_the_pose_rotation() {
         rotations.push(nalgebra::UnitQuaternion::from_quaternion(q));
     }
     for r in rotations {
-        let q = super::outputs::lsdem_quaternion(&r);
+        let q = levelset::io::lsdem::lsdem_quaternion(&r);
         assert!(q[3] >= 0.0, "W ≥ 0");
-        let m = super::outputs::lsdem_matrix(q);
+        let m = levelset::io::lsdem::lsdem_matrix(q);
         approx::assert_relative_eq!(m, *r.to_rotation_matrix().matrix(), epsilon = 1e-12);
         // body → world: a body point lands where the pose puts it
         let p = nalgebra::Point3::new(0.3, -1.7, 2.2);
@@ -483,70 +492,57 @@ fn base64_matches_rfc_4648_and_round_trips() {
     assert_eq!(super::outputs::base64_decode(&enc(&bytes)), Some(bytes));
 }
 
-/// Spheres of different clumps that overlap, or cross a wall, are trimmed
-/// until none does; spheres of one clump keep their overlap.
+/// Spheres of different grains that overlap, or cross a wall, are trimmed
+/// until none does; spheres of one clump keep their overlap; grains that copy
+/// one shape share its trimmed clump.
 #[test]
 fn separate_clumps_leaves_no_overlap_between_clumps_or_with_walls() {
-    use super::outputs::{PlacedClump, separate_clumps};
     use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
+    use packer_quadtree::separate_clumps;
     let at =
         |x: f64| Isometry3::from_parts(Translation3::new(x, 5.0, 5.0), UnitQuaternion::identity());
-    let mut clumps = vec![
-        PlacedClump {
-            index: 0,
-            pose: at(4.0),
-            spheres: vec![(Point3::origin(), 1.0), (Point3::new(0.5, 0.0, 0.0), 1.0)],
-        },
-        PlacedClump {
-            index: 1,
-            pose: at(6.2),
-            spheres: vec![(Point3::origin(), 1.0)],
-        },
-        PlacedClump {
-            index: 2,
-            pose: at(0.5),
-            spheres: vec![(Point3::origin(), 1.0)],
-        },
+    let mut shapes = vec![
+        vec![(Point3::origin(), 1.0), (Point3::new(0.5, 0.0, 0.0), 1.0)],
+        vec![(Point3::origin(), 1.0)],
+        vec![(Point3::origin(), 1.0)],
     ];
+    let poses = [at(4.0), at(6.2), at(0.5)];
     let c = packer_quadtree::Container::walled_box(nalgebra::Vector3::new(10.0, 10.0, 10.0));
-    let t = separate_clumps(&mut clumps, &c).expect("trims");
+    let t = separate_clumps(&mut shapes, &poses, |k| k, &c).expect("trims");
     assert_eq!(t.walls, 1);
     assert!(t.pairs == 1 && t.trimmed == 3, "{t:?}");
     assert!(t.volume_change < 0.0);
-    // sphere (4.5, r) against (6.2, r): overlap 0.3 → each loses 0.15
-    let world: Vec<(Point3<f64>, f64, u64)> = clumps
-        .iter()
-        .flat_map(|k| {
-            k.spheres
-                .iter()
-                .map(move |(p, r)| (k.pose * p, *r, k.index))
-        })
-        .collect();
-    for (i, a) in world.iter().enumerate() {
-        assert!(c.clearance(&a.0) >= a.1, "sphere {i} crosses a wall");
-        for b in &world[i + 1..] {
-            if a.2 != b.2 {
-                assert!((a.0 - b.0).norm() >= a.1 + b.1, "{a:?} {b:?}");
+    let check = |shapes: &[Vec<(Point3<f64>, f64)>],
+                 poses: &[Isometry3<f64>],
+                 of: &dyn Fn(usize) -> usize| {
+        let world: Vec<(Point3<f64>, f64, usize)> = poses
+            .iter()
+            .enumerate()
+            .flat_map(|(g, p)| shapes[of(g)].iter().map(move |(c, r)| (p * c, *r, g)))
+            .collect();
+        for (i, a) in world.iter().enumerate() {
+            assert!(c.clearance(&a.0) >= a.1, "sphere {i} crosses a wall");
+            for b in &world[i + 1..] {
+                if a.2 != b.2 {
+                    assert!((a.0 - b.0).norm() >= a.1 + b.1, "{a:?} {b:?}");
+                }
             }
         }
-    }
+    };
+    check(&shapes, &poses, &|k| k);
     // the two spheres of clump 0 still overlap each other
-    let s = &clumps[0].spheres;
+    let s = &shapes[0];
     assert!((s[0].0 - s[1].0).norm() < s[0].1 + s[1].1);
+    // three copies of one shape: one template, cut for the worst copy
+    let mut one = vec![vec![(Point3::origin(), 1.0)]];
+    let copies = [at(2.0), at(3.9), at(8.5)];
+    let t = separate_clumps(&mut one, &copies, |_| 0, &c).expect("trims");
+    assert_eq!(t.trimmed, 1);
+    check(&one, &copies, &|_| 0);
+    approx::assert_relative_eq!(one[0][0].1, 0.95, max_relative = 1e-6);
     // a sphere that would lose nearly all of its radius is an error
-    let mut deep = vec![
-        PlacedClump {
-            index: 0,
-            pose: at(5.0),
-            spheres: vec![(Point3::origin(), 1.0)],
-        },
-        PlacedClump {
-            index: 1,
-            pose: at(5.05),
-            spheres: vec![(Point3::origin(), 1.0)],
-        },
-    ];
-    let e = separate_clumps(&mut deep, &c)
+    let mut deep = vec![vec![(Point3::origin(), 1.0)], vec![(Point3::origin(), 1.0)]];
+    let e = separate_clumps(&mut deep, &[at(5.0), at(5.05)], |k| k, &c)
         .expect_err("too deep")
         .to_string();
     assert!(e.contains("spheres per clump"), "{e}");

@@ -314,6 +314,92 @@ pub fn write_rotations(mut w: impl Write, rotations: &[UnitQuaternion<f64>]) -> 
     Ok(())
 }
 
+/// One file of an LS-DEM input folder, relative to it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LayoutEntry {
+    /// A file and its bytes.
+    File {
+        /// Path relative to the input folder.
+        path: String,
+        /// Contents.
+        bytes: Vec<u8>,
+    },
+    /// A relative symbolic link: `path` reads the morph file `target` (same folder).
+    Link {
+        /// Path relative to the input folder.
+        path: String,
+        /// The link's target, relative to `path`'s folder.
+        target: String,
+    },
+}
+
+/// The LS-DEM input folder of `grains` beside their morph files (written by the caller as
+/// [`morph_path`]`(m + 1)` for each distinct morph `m`): `InitState/positions_<NAME>.dat`
+/// (the centres of mass, grid units), `InitState/rotations_<NAME>.dat`
+/// ([`lsdem_quaternion`]), and for every grain `k` that reuses morph `m ≠ k` a link
+/// `Morphologies/morph_<k+1>.dat → morph_<m+1>.dat`, so that any LS-DEM reader finds the
+/// `k`-th line's morph file under its own number while the disk holds each shape once.
+///
+/// `grains[k] = (m, pose)`: grain `k` uses morph `m` (0-based) and `pose` maps the morph's
+/// frame (grid units, origin at its centre of mass) to the world (grid units).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a test name that is empty or not made of ASCII letters,
+/// digits, `_` and `-`, a morph index above its grain's (morph `m` must be written as a
+/// file, i.e. be some grain's own), or a non-finite pose.
+pub fn layout(name: &str, grains: &[(usize, Isometry3<f64>)]) -> Result<Vec<LayoutEntry>> {
+    if name.is_empty()
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    {
+        return Err(Error::InvalidParameter {
+            name: "LS-DEM test name length",
+            value: name.len() as f64,
+            requirement: "a non-empty name of ASCII letters, digits, `_` and `-`",
+        });
+    }
+    let mut positions = Vec::with_capacity(grains.len());
+    let mut rotations = Vec::with_capacity(grains.len());
+    let mut out = Vec::new();
+    for (k, (m, pose)) in grains.iter().enumerate() {
+        if *m > k {
+            return Err(Error::InvalidParameter {
+                name: "LS-DEM morph index",
+                value: *m as f64,
+                requirement: "at most its grain's index (the morph of a grain that comes first)",
+            });
+        }
+        positions.push(Point3::from(pose.translation.vector));
+        rotations.push(pose.rotation);
+        if *m != k {
+            out.push(LayoutEntry::Link {
+                path: morph_path(k + 1),
+                target: format!("morph_{}.dat", m + 1),
+            });
+        }
+    }
+    let mut pos = Vec::new();
+    write_positions(&mut pos, &positions)?;
+    let mut rot = Vec::new();
+    write_rotations(&mut rot, &rotations)?;
+    out.insert(
+        0,
+        LayoutEntry::File {
+            path: rotations_path(name),
+            bytes: rot,
+        },
+    );
+    out.insert(
+        0,
+        LayoutEntry::File {
+            path: positions_path(name),
+            bytes: pos,
+        },
+    );
+    Ok(out)
+}
+
 /// Reads a positions or rotations file: `n` whitespace-separated numbers per non-empty line.
 ///
 /// # Errors
@@ -452,6 +538,36 @@ mod tests {
         assert!(principal_morph(&g, 0.0, 1.0, 10).is_err());
         assert!(principal_morph(&g, f64::NAN, 1.0, 10).is_err());
         assert!(principal_morph(&g, 0.05, -1.0, 10).is_err());
+    }
+
+    #[test]
+    fn layout_links_reused_morphs_and_refuses_bad_input() {
+        let p = |x: f64| Isometry3::translation(x, 0.0, 0.0);
+        let grains = [(0, p(1.0)), (1, p(2.0)), (0, p(3.0)), (1, p(4.0))];
+        let l = layout("t", &grains).expect("layout");
+        assert_eq!(l.len(), 4);
+        assert!(
+            matches!(&l[0], LayoutEntry::File { path, .. } if path == "InitState/positions_t.dat")
+        );
+        assert!(
+            matches!(&l[1], LayoutEntry::File { path, .. } if path == "InitState/rotations_t.dat")
+        );
+        assert_eq!(
+            l[2],
+            LayoutEntry::Link {
+                path: "Morphologies/morph_3.dat".into(),
+                target: "morph_1.dat".into()
+            }
+        );
+        if let LayoutEntry::File { bytes, .. } = &l[0] {
+            let rows = read_rows::<3>(bytes.as_slice(), "positions").expect("rows");
+            assert_eq!(rows[3], [4.0, 0.0, 0.0]);
+        }
+        assert!(layout("", &grains).is_err());
+        assert!(layout("a/b", &grains).is_err());
+        assert!(layout("t", &[(1, p(0.0))]).is_err());
+        let nan = Isometry3::translation(f64::NAN, 0.0, 0.0);
+        assert!(layout("t", &[(0, nan)]).is_err());
     }
 
     #[test]

@@ -12,6 +12,7 @@ pub mod parents;
 mod perez_morales;
 mod rounding;
 pub mod specimen;
+mod specimen_dem;
 mod sph_harmonics;
 
 /// Every registered case, in a stable order.
@@ -26,6 +27,7 @@ pub fn registry() -> Vec<Case> {
     cases.extend(parents::cases());
     cases.extend(perez_morales::cases());
     cases.extend(specimen::cases());
+    cases.extend(specimen_dem::cases());
     cases.extend(sph_harmonics::cases());
     cases
 }
@@ -42,6 +44,7 @@ pub fn expected_failures() -> Vec<ExpectedFailure> {
     list.extend_from_slice(parents::EXPECTED_FAILURES);
     list.extend_from_slice(perez_morales::EXPECTED_FAILURES);
     list.extend_from_slice(specimen::EXPECTED_FAILURES);
+    list.extend_from_slice(specimen_dem::EXPECTED_FAILURES);
     list.extend_from_slice(sph_harmonics::EXPECTED_FAILURES);
     list
 }
