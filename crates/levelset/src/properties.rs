@@ -197,6 +197,20 @@ impl Grid {
         finish_mass(s, corrections)
     }
 
+    /// Volume, area, centroid and inertia tensor of the piecewise-linear zero set alone,
+    /// without the sharp-feature correction of [`Grid::mass_properties`] (as
+    /// [`Grid::volume_linear`]). Its integrals are smooth functions of the grid values,
+    /// whereas the correction switches on and off per cell with a threshold on the
+    /// corners' gradients: what an iteration on the values needs
+    /// ([`crate::io::principal_morph`]).
+    ///
+    /// # Errors
+    /// [`Error::NoSurface`] if the enclosed volume is not positive.
+    pub fn mass_properties_linear(&self) -> Result<MassProperties> {
+        let (s, _) = self.integrate::<true, true, false>();
+        finish_mass(s, Vec::new())
+    }
+
     /// [`Grid::mass_properties`] from a [`Surface`] extracted from this grid
     /// ([`Grid::surface`]): the integrals over its mesh and the sharp-feature corrections
     /// of its crossed cells, without walking the grid again (the same values bit for bit;

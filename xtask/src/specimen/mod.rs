@@ -28,6 +28,7 @@ use packer_quadtree::{Container, Sphere, StarGrain};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
+mod estimate;
 mod outputs;
 mod place;
 mod report;
@@ -178,6 +179,12 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             bail!("`parents.path`: {} does not exist", p.display());
         }
     }
+    // memory and disk, estimated before any work
+    let need_est = estimate::Estimate::of(scene);
+    need_est.check(
+        estimate::available_memory(),
+        estimate::free_disk(&root.join(&scene.out_dir)),
+    )?;
     let staging = Staging::new(&root.join(&scene.out_dir))?;
 
     // parents
@@ -231,7 +238,15 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             (&owned, format!("{summary}, DNA {dna_s:.2} s"))
         }
     };
-    st.ran("parents", t, note);
+    st.ran(
+        "parents",
+        t,
+        format!(
+            "{note}; estimated need: memory {}, disk {}",
+            estimate::human(need_est.memory),
+            estimate::human(need_est.disk)
+        ),
+    );
 
     // clone
     let t = Instant::now();

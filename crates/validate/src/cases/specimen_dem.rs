@@ -2,7 +2,8 @@
 //! specimens").
 //!
 //! Every case packs calibrated Ottawa clones with `packer_quadtree::pack_grains` in a
-//! triaxial cylinder at a solid fraction of 0.50 (as `cargo xtask specimen` does) and takes
+//! triaxial cylinder at a solid fraction of 0.50 (0.40 for the 60 grains of the LS-DEM
+//! case, whose cylinder is only a few grains wide), as `cargo xtask specimen` does, and takes
 //! each grain's level set from its packed star table (45³ nodes over ±1.1 r_max).
 //!
 //! `specimen/lsdem-files`: 60 grains written as an LS-DEM input folder
@@ -11,10 +12,10 @@
 //! read back the way LS-DEM's loader does (`Morphologies/morph_<i+1>.dat` for line `i`,
 //! built here from its own format string): no missing file; each morph file's level set
 //! (parsed from the file) principal, `max |I_ij| / I_max ≤ 1e-9` by
-//! `Grid::mass_properties`, its moments the diagonal; the surface nodes placed by the
+//! `Grid::mass_properties_linear`, its moments the diagonal; the surface nodes placed by the
 //! parsed positions and LS-DEM's rotation matrix of the parsed quaternions equal to the
 //! packed pose applied to the same nodes within 1e-9 d_eq; and those nodes on the packed
-//! star surface (within 2 % of d_eq: resampling and node placement). A second folder in
+//! grain's surface (its level set in the body frame: within 2 % of d_eq, the resampling). A second folder in
 //! which 60 grains reuse 20 morphs checks that every line resolves to its shape's file.
 //!
 //! `specimen/clump-mass`: 200 grains as clumps of 10, 20 and 50 spheres
@@ -68,7 +69,52 @@ pub(crate) fn cases() -> Vec<Case> {
 }
 
 /// Known failures with their reasons.
-pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[];
+pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
+    ExpectedFailure {
+        case: "specimen/clump-mass",
+        metric: "10 spheres: union mean |volume error| %",
+        reason: TRIM_10,
+    },
+    ExpectedFailure {
+        case: "specimen/clump-mass",
+        metric: "10 spheres: union worst |volume error| %",
+        reason: TRIM_10,
+    },
+    ExpectedFailure {
+        case: "specimen/clump-mass",
+        metric: "10 spheres: union mean inertia-tensor error %",
+        reason: TRIM_10,
+    },
+    ExpectedFailure {
+        case: "specimen/clump-mass",
+        metric: "10 spheres: union mean centroid offset / d",
+        reason: TRIM_10,
+    },
+    ExpectedFailure {
+        case: "specimen/clump-shape",
+        metric: "10 spheres: clump volume mean |error| %",
+        reason: TRIM_10,
+    },
+    ExpectedFailure {
+        case: "specimen/clump-shape",
+        metric: "10 spheres: clump roundness mean |error| %",
+        reason: ROUNDNESS,
+    },
+    ExpectedFailure {
+        case: "specimen/clump-shape",
+        metric: "20 spheres: clump roundness mean |error| %",
+        reason: ROUNDNESS,
+    },
+    ExpectedFailure {
+        case: "specimen/clump-shape",
+        metric: "50 spheres: clump roundness mean |error| %",
+        reason: ROUNDNESS,
+    },
+];
+
+const TRIM_10: &str = "A 10-sphere clump of a packed grain loses more to the trimming against its neighbours and the walls (its spheres are larger and reach farther past the grain's surface, across the 1 % packing margin): measured 3.5 % mean and 9.7 % worst volume, 7.2 % inertia, 0.017 d centroid offset on 200 packed Ottawa clones. Use 20 or more spheres for a specimen (20: 1.4 % / 3.7 %; 50: 0.4 % / 1.6 %).";
+
+const ROUNDNESS: &str = "3D roundness (mean corner curvature radius over the inscribed radius) of a sphere union is set by its spheres, not by the grain's corners: the union is bumpy at the scale of its spheres (convex bumps and concave crevices), so the measured roundness differs from the level set's by 33 / 15 / 10.0 % at 10 / 20 / 50 spheres (200 packed Ottawa clones). Volume, V/S and aspect ratio of the delivered clumps are within 5 % at 20 and 50 spheres; roundness needs more spheres than a DEM run can afford, or a level-set DEM (LS-DEM output).";
 
 /// Level-set nodes per axis of the grains.
 const RESOLUTION: usize = 45;
@@ -88,8 +134,8 @@ struct Packed {
     poses: Vec<Isometry3<f64>>,
 }
 
-/// `n` calibrated Ottawa clones packed at 0.50 in a cylinder H = 2D, with level sets.
-fn packed(n: u64) -> Result<Packed, Error> {
+/// `n` calibrated Ottawa clones packed at `fraction` in a cylinder H = 2D, with level sets.
+fn packed(n: u64, fraction: f64) -> Result<Packed, Error> {
     let err = Error::computation;
     let parents = crate::grains::ottawa_parents()?;
     let mut cal = Calibrated::from_ron(fixtures::calibrated("gsc2-ottawa.ron")?).map_err(err)?;
@@ -106,7 +152,7 @@ fn packed(n: u64) -> Result<Packed, Error> {
         })
         .collect::<Result<_, Error>>()?;
     let container =
-        container_for(&Container::triaxial(1.0), &grains, 0.5).map_err(Error::computation)?;
+        container_for(&Container::triaxial(1.0), &grains, fraction).map_err(Error::computation)?;
     let packing = pack_grains(&grains, &container, &GrainPackParams::default())
         .map_err(Error::computation)?;
     let grids = grains
@@ -130,13 +176,14 @@ fn clump_specimen() -> Result<&'static Packed, Error> {
     if let Some(p) = SPECIMEN.get() {
         return Ok(p);
     }
-    let p = packed(200)?;
+    let p = packed(200, 0.5)?;
     Ok(SPECIMEN.get_or_init(|| p))
 }
 
 fn lsdem_files() -> Result<Vec<Check>, Error> {
     let err = Error::computation;
-    let sp = packed(60)?;
+    // 60 grains fill a cylinder only a few grains wide: a looser 0.40
+    let sp = packed(60, 0.4)?;
     // one grid spacing for every morph file: the median grain's own
     let mut own: Vec<f64> = sp.grids.iter().map(Grid::spacing).collect();
     own.sort_by(f64::total_cmp);
@@ -188,7 +235,7 @@ fn lsdem_files() -> Result<Vec<Check>, Error> {
             continue;
         };
         let m = levelset::io::read_morph(bytes).map_err(err)?;
-        let mp = m.grid.mass_properties().map_err(err)?;
+        let mp = m.grid.mass_properties_linear().map_err(err)?;
         worst_off = worst_off.max(lsdem::off_diagonal(&mp.inertia));
         for a in 0..3 {
             let d = mp.inertia[(a, a)];
@@ -202,10 +249,9 @@ fn lsdem_files() -> Result<Vec<Check>, Error> {
             let lsdem_world = (pos + r * node.coords) * h;
             let ours = exact * (node * h);
             worst_place = worst_place.max((lsdem_world - ours.coords).norm() / d);
-            // on the packed star surface
+            // on the packed grain's surface: its own level set in the body frame
             let body = sp.poses[i].inverse() * Point3::from(lsdem_world);
-            let gap = body.coords.norm() - sp.grains[i].radius(&body.coords);
-            worst_surface = worst_surface.max(gap.abs() / d);
+            worst_surface = worst_surface.max(sp.grids[i].value(&body).abs() / d);
         }
     }
     // reuse: 60 lines over 20 morphs
@@ -261,7 +307,7 @@ fn lsdem_files() -> Result<Vec<Check>, Error> {
             Tolerance::AtMost(0.0),
         ),
         Check::new(
-            "worst node distance to the packed star surface, / d",
+            "worst node distance to the packed grain's surface (its level set), / d",
             0.02,
             worst_surface,
             Tolerance::AtMost(0.0),
