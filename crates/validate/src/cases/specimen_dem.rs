@@ -15,7 +15,8 @@
 //! `Grid::mass_properties_linear`, its moments the diagonal; the surface nodes placed by the
 //! parsed positions and LS-DEM's rotation matrix of the parsed quaternions equal to the
 //! packed pose applied to the same nodes within 1e-9 d_eq; and those nodes on the packed
-//! grain's surface (its level set in the body frame: within 2 % of d_eq, the resampling). A second folder in
+//! grain's surface (its level set in the body frame: within one grid spacing, the
+//! resampling). A second folder in
 //! which 60 grains reuse 20 morphs checks that every line resolves to its shape's file.
 //!
 //! `specimen/clump-mass`: 200 grains as clumps of 10, 20 and 50 spheres
@@ -251,7 +252,7 @@ fn lsdem_files() -> Result<Vec<Check>, Error> {
             worst_place = worst_place.max((lsdem_world - ours.coords).norm() / d);
             // on the packed grain's surface: its own level set in the body frame
             let body = sp.poses[i].inverse() * Point3::from(lsdem_world);
-            worst_surface = worst_surface.max(sp.grids[i].value(&body).abs() / d);
+            worst_surface = worst_surface.max(sp.grids[i].value(&body).abs() / h);
         }
     }
     // reuse: 60 lines over 20 morphs
@@ -307,8 +308,8 @@ fn lsdem_files() -> Result<Vec<Check>, Error> {
             Tolerance::AtMost(0.0),
         ),
         Check::new(
-            "worst node distance to the packed grain's surface (its level set), / d",
-            0.02,
+            "worst node distance to the packed grain's surface (its level set), in grid spacings",
+            1.0,
             worst_surface,
             Tolerance::AtMost(0.0),
         ),
