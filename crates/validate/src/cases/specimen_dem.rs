@@ -122,7 +122,7 @@ const RESOLUTION: usize = 45;
 /// Half-width of a grain's grid over its largest radius (the cloner's `grid_margin`).
 const MARGIN: f64 = 1.1;
 /// Lattice cells per equivalent diameter of the union integration (as `xtask specimen`).
-const UNION_CELLS: f64 = 100.0;
+const UNION_CELLS: f64 = 60.0;
 
 /// A clump's spheres: centre and radius.
 type Clump = Vec<(Point3<f64>, f64)>;
