@@ -485,6 +485,8 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     let mut frames: Vec<Option<LsdemFrame>> = vec![None; n_templates];
     let mut template_spheres: Vec<Vec<(Point3<f64>, f64)>> = vec![Vec::new(); n_templates];
     let mut template_volume: Vec<f64> = vec![f64::NAN; n_templates];
+    let mut template_dna: Vec<Option<(levelset::GridSpec, Vec<f64>)>> = Vec::new();
+    let mut clump_section: Option<String> = None;
     let mut meshes: Vec<Option<levelset::TriMesh>> = Vec::new();
     let ns = [
         AtomicU64::new(0), // rasterise
@@ -554,6 +556,15 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                         g.shrunk = cl.shrunk;
                         g.volume = grid.volume();
                         g.clump = Some(cl.spheres);
+                        if out.report {
+                            let dna = morph_dna::measure(
+                                &grid,
+                                &CLUMP_DNA,
+                                &morph_dna::MeasureParams::default(),
+                            )
+                            .with_context(|| format!("DNA of clone {}", c.index))?;
+                            g.dna = Some((*grid.spec(), dna));
+                        }
                     }
                     let t3 = Instant::now();
                     ns[2].fetch_add((t3 - t2).as_nanos() as u64, Ordering::Relaxed);
@@ -573,6 +584,10 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 if let Some(c) = g.clump {
                     template_spheres[k] = c;
                     template_volume[k] = g.volume;
+                }
+                if let Some(d) = g.dna {
+                    template_dna.resize(n_templates, None);
+                    template_dna[k] = Some(d);
                 }
                 shrunk += g.shrunk;
                 if let Some(m) = g.mesh {
@@ -722,6 +737,15 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 })
                 .sum::<f64>()
                 / k;
+            if out.report {
+                clump_section = Some(clump_dna_section(
+                    &template_spheres,
+                    &template_dna,
+                    &unions,
+                    &template_volume,
+                    out.clump.spheres_per_clump,
+                )?);
+            }
             clumps = (0..n_grains)
                 .map(|g| {
                     let tpl = template_of(g);
@@ -826,7 +850,10 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 .zip(&scales)
                 .map(|(c, s)| equivalent(c) * s)
                 .collect();
-            let files = report::write(parents, &run, &diameters, &scene.clones, &cal.name)?;
+            let mut files = report::write(parents, &run, &diameters, &scene.clones, &cal.name)?;
+            if let (Some(sec), Some(md)) = (&clump_section, files.first_mut()) {
+                md.1.push_str(sec);
+            }
             for (name, bytes) in &files {
                 staging.write(name, bytes.as_bytes())?;
             }
@@ -1025,9 +1052,73 @@ fn coarsen(grid: &levelset::Grid, cells: usize) -> anyhow::Result<Option<levelse
     Ok(Some(levelset::Grid::from_fn(spec, |p| grid.value(p))?))
 }
 
+/// The DNA compared between a grain's level set and its delivered clump.
+const CLUMP_DNA: [morph_dna::Descriptor; 4] = [
+    morph_dna::Descriptor::Volume,
+    morph_dna::Descriptor::VolumeSurfaceRatio,
+    morph_dna::Descriptor::AspectRatio,
+    morph_dna::Descriptor::Roundness,
+];
+
+/// The report's section on the clumps as delivered (after trimming): their DNA, each
+/// union rasterised on its grain's own grid, and their union mass against the level sets.
+fn clump_dna_section(
+    spheres: &[Vec<(Point3<f64>, f64)>],
+    dna: &[Option<(levelset::GridSpec, Vec<f64>)>],
+    unions: &[levelset::MassProperties],
+    volumes: &[f64],
+    per_clump: usize,
+) -> anyhow::Result<String> {
+    let errors: Vec<Vec<f64>> = spheres
+        .par_iter()
+        .zip(dna)
+        .filter_map(|(s, d)| d.as_ref().map(|d| (s, d)))
+        .map(|(s, (spec, ours))| {
+            let union = levelset::Grid::from_fn(*spec, |p| {
+                s.iter()
+                    .fold(f64::INFINITY, |m, (c, r)| m.min((p - c).norm() - r))
+            })?;
+            let theirs =
+                morph_dna::measure(&union, &CLUMP_DNA, &morph_dna::MeasureParams::default())?;
+            Ok(theirs
+                .iter()
+                .zip(ours)
+                .map(|(c, l)| 100.0 * (c / l - 1.0))
+                .collect())
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let k = errors.len().max(1) as f64;
+    let mut md = format!(
+        "\n## Clumps as delivered ({per_clump} spheres per clump, after trimming)\n\n\
+         The body a clump DEM code moves, against the grain's level set: DNA of the sphere union \
+         rasterised on the grain's own grid (mean and mean |error| over {} clumps), and the \
+         union's mass properties (`levelset::union_mass_properties`).\n\n\
+         | parameter | mean error % | mean \\|error\\| % |\n| --- | --- | --- |\n",
+        errors.len()
+    );
+    for (i, d) in CLUMP_DNA.iter().enumerate() {
+        let mean = errors.iter().map(|e| e[i]).sum::<f64>() / k;
+        let abs = errors.iter().map(|e| e[i].abs()).sum::<f64>() / k;
+        md.push_str(&format!("| {} | {mean:+.2} | {abs:.2} |\n", d.name()));
+    }
+    let vol = unions
+        .iter()
+        .zip(volumes)
+        .map(|(u, v)| 100.0 * (u.volume / v - 1.0).abs())
+        .sum::<f64>()
+        / unions.len().max(1) as f64;
+    md.push_str(&format!(
+        "\nUnion volume (mass) against the level set: mean |error| {vol:.2} %. \
+         The masses and inertias given to LAMMPS, LIGGGHTS and Yade are the union's.\n"
+    ));
+    Ok(md)
+}
+
 /// The products of the level-set stage for one distinct shape.
 #[derive(Default)]
 struct GrainOut {
+    /// The level set's spec and DNA ([`CLUMP_DNA`]) when a report of the clumps is asked.
+    dna: Option<(levelset::GridSpec, Vec<f64>)>,
     lsdem: Option<LsdemFrame>,
     clump: Option<Vec<(Point3<f64>, f64)>>,
     /// The level set's volume (scene units) when a clump was made.
