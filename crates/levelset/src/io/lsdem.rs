@@ -170,22 +170,7 @@ pub fn principal_morph(
         let jac = match jacobian {
             Some(j) => j,
             None => {
-                // d(products)/d(coefficient), by one forward difference per basis function
-                let eps = 1e-3 * spacing;
-                let mut j = Matrix3::zeros();
-                let base = products(&lp.inertia);
-                for b in 0..3 {
-                    let spec = *local.spec();
-                    let values: Vec<f64> = local
-                        .values()
-                        .iter()
-                        .enumerate()
-                        .map(|(idx, v)| v + eps * basis(&node_of(&spec, idx), &c0)[b])
-                        .collect();
-                    let g = Grid::new(spec, values)?;
-                    let i = g.mass_properties_linear()?.inertia;
-                    j.set_column(b, &((products(&i) - base) / eps));
-                }
+                let j = shape_jacobian(&local, &lp.centroid, &c0, reach);
                 jacobian = Some(j);
                 j
             }
@@ -211,6 +196,35 @@ pub fn principal_morph(
         local = Grid::new(spec, values)?;
         lp = local.mass_properties_linear()?;
     }
+}
+
+/// `∂(I_xy, I_xz, I_yz) / ∂(a, b, c)` of the correction `φ += a·xy + b·xz + c·yz`
+/// (coordinates about `c0` over `reach`), by the shape derivative: raising φ by `δφ` moves
+/// the zero set inward by `δφ / |∇φ|`, so `∂/∂a ∫_Ω f dV = −∫_∂Ω f · xy / |∇φ| dA`; with
+/// `I_xy = −∫ x y dV` about the centroid (its shift is second order there) the column of
+/// `a` is `∫_∂Ω (xy, xz, yz) · xy dA` (|∇φ| ≈ 1 near the zero set of a distance field),
+/// summed over the marching-cubes triangles at their centroids. One surface pass instead
+/// of three integrations by finite differences; a Newton step only needs it approximately.
+fn shape_jacobian(
+    grid: &Grid,
+    centroid: &Point3<f64>,
+    c0: &Point3<f64>,
+    reach: f64,
+) -> Matrix3<f64> {
+    let mesh = grid.marching_cubes();
+    let v = mesh.vertices();
+    let mut j = Matrix3::zeros();
+    for t in mesh.triangles() {
+        let (a, b, c) = (v[t[0]], v[t[1]], v[t[2]]);
+        let area = 0.5 * (b - a).cross(&(c - a)).norm();
+        let m = Point3::from((a.coords + b.coords + c.coords) / 3.0);
+        let x = m - centroid;
+        let d = (m - c0) / reach;
+        let prods = Vector3::new(x.x * x.y, x.x * x.z, x.y * x.z);
+        let basis = Vector3::new(d.x * d.y, d.x * d.z, d.y * d.z);
+        j += area * prods * basis.transpose();
+    }
+    j
 }
 
 /// Position of the node of storage index `idx` (x fastest).
