@@ -28,6 +28,8 @@ use packer_quadtree::{Container, Sphere, StarGrain};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
+pub(crate) mod check;
+mod dem;
 mod estimate;
 mod outputs;
 mod place;
@@ -36,7 +38,7 @@ mod scene;
 #[cfg(test)]
 mod tests;
 
-use outputs::{LsdemFrame, PlacedClump, Staging, Surfaces, VtuWriter};
+use outputs::{LsdemFrame, Staging, Surfaces, VtuWriter};
 use scene::{Clones, ContainerSpec, ParentsSpec, Placement, Scene};
 
 /// Cube-map cells per face of the star tables the grain packer packs (and
@@ -696,7 +698,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     }
     // clumps (shared by the three clump outputs): one clump per distinct shape, trimmed
     // against every copy's neighbours, then the union's mass properties per shape
-    let mut clumps: Vec<PlacedClump> = Vec::new();
+    let mut dem_templates: Vec<dem::Template> = Vec::new();
     match need(out.clumps(), "clump output") {
         Some(r) => st.skip("clumps", &r),
         None => {
@@ -746,23 +748,17 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                     out.clump.spheres_per_clump,
                 )?);
             }
-            clumps = (0..n_grains)
-                .map(|g| {
-                    let tpl = template_of(g);
-                    PlacedClump {
-                        index: g as u64,
-                        template: tpl,
-                        pose: scale_pose(&poses[g], metres),
-                        spheres: template_spheres[tpl]
-                            .iter()
-                            .map(|(c, r)| (c * metres, r * metres))
-                            .collect(),
-                        volume: unions[tpl].volume * metres.powi(3),
-                        centroid: unions[tpl].centroid * metres,
-                        inertia: unions[tpl].inertia * metres.powi(5),
-                    }
+            dem_templates = template_spheres
+                .iter()
+                .zip(&unions)
+                .map(|(s, u)| dem::Template {
+                    spheres: s.iter().map(|(c, r)| (c * metres, r * metres)).collect(),
+                    volume: u.volume * metres.powi(3),
+                    centroid: u.centroid * metres,
+                    inertia: u.inertia * metres.powi(5),
                 })
                 .collect();
+
             st.ran_s(
                 "clumps",
                 cpu(2) + t.elapsed().as_secs_f64(),
@@ -788,18 +784,36 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         }
     }
     let container_m = scale_container(&container, metres);
+    let dem_bodies: Vec<dem::Body> = (0..n_grains)
+        .map(|k| dem::Body {
+            template: template_of(k),
+            pose: scale_pose(&poses[k], metres),
+        })
+        .collect();
+    let dem_specimen = dem::DemSpecimen {
+        templates: &dem_templates,
+        bodies: &dem_bodies,
+        container: &container_m,
+        material: &out.material,
+        density: out.density,
+        provenance: &provenance,
+    };
     match need(out.lammps_clumps, "LAMMPS clumps") {
         Some(r) => st.skip("lammps", &r),
         None => {
             let t = Instant::now();
-            let (data, body) = outputs::lammps_clumps(&clumps, &container_m, out.density)?;
-            staging.write("lammps/clumps.data", &data)?;
-            staging.write("lammps/clumps.body", body.as_bytes())?;
-            staging.write("lammps/in.clumps", lammps_input().as_bytes())?;
+            let files = dem::lammps_files(&dem_specimen)?;
+            for (name, bytes) in &files {
+                staging.write(name, bytes)?;
+            }
+            let sp = dem_specimen.settle()?;
             st.ran(
                 "lammps",
                 t,
-                "lammps/clumps.data + clumps.body + in.clumps".into(),
+                format!(
+                    "lammps/clumps.data + bodies.rigid (union mass, centre, inertia per body) + in.settle (Hertz-Mindlin, E/{}, dt {:.3e} s = 0.2 Rayleigh of the smallest clump, settle to KE <= {:.3e} J)",
+                    out.material.stiffness_scale, sp.dt, sp.ke_limit
+                ),
             );
         }
     }
@@ -807,15 +821,17 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         Some(r) => st.skip("liggghts", &r),
         None => {
             let t = Instant::now();
-            let (files, script) = outputs::liggghts_templates(&clumps, out.density);
-            for (name, text) in &files {
-                staging.write(&format!("liggghts/{name}"), text.as_bytes())?;
+            let files = dem::liggghts_files(&dem_specimen)?;
+            for (name, bytes) in &files {
+                staging.write(name, bytes)?;
             }
-            staging.write("liggghts/templates.in", script.as_bytes())?;
             st.ran(
                 "liggghts",
                 t,
-                format!("{} templates + liggghts/templates.in", files.len()),
+                format!(
+                    "{} multisphere templates (union mass and inertia) + liggghts/templates.in (numberbased weights)",
+                    files.len() - 1
+                ),
             );
         }
     }
@@ -823,9 +839,14 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         Some(r) => st.skip("yade", &r),
         None => {
             let t = Instant::now();
-            staging.write("yade/clumps.txt", outputs::yade_clumps(&clumps).as_bytes())?;
-            staging.write("yade/load_clumps.py", outputs::YADE_SCRIPT.as_bytes())?;
-            st.ran("yade", t, "yade/clumps.txt + load_clumps.py".into());
+            for (name, bytes) in &dem::yade_files(&dem_specimen)? {
+                staging.write(name, bytes)?;
+            }
+            st.ran(
+                "yade",
+                t,
+                "yade/clumps.txt + settle.py (Hertz-Mindlin, appendClumped with discretization, settle) + settle.txt".into(),
+            );
         }
     }
     match need(out.vtu, "VTU") {
@@ -1209,30 +1230,4 @@ fn fixed_container(spec: &ContainerSpec) -> Container {
         // sized by the caller
         ContainerSpec::AutoCylinder { .. } => Container::triaxial(1.0),
     }
-}
-
-/// `lammps/in.clumps`: the LAMMPS lines that read the clumps as rigid
-/// bodies (checked with LAMMPS 2024+: `2 rigid bodies with 4 atoms` on a
-/// small case; the body ids become molecule ids so that the overlapping
-/// spheres of one body do not interact).
-fn lammps_input() -> String {
-    "# grainforge specimen: read the clumps into LAMMPS as rigid bodies (run from out_dir/lammps).\n\
-     # Contact model, walls, gravity, thermo output and time step are yours; these lines load the specimen.\n\
-     units           si\n\
-     dimension       3\n\
-     atom_style      sphere\n\
-     atom_modify     map array   # atomfile variables need an atom map\n\
-     boundary        f f f\n\
-     comm_modify     vel yes\n\
-     read_data       clumps.data\n\
-     variable        body atomfile clumps.body\n\
-     # body ids as molecule ids: spheres of one body overlap, so exclude their pairs\n\
-     fix             mol all property/atom mol ghost yes\n\
-     set             group all mol v_body\n\
-     neigh_modify    exclude molecule/intra all\n\
-     fix             clumps all rigid/small molecule\n\
-     # (without the exclusion: fix clumps all rigid/small custom v_body)\n\
-     # the default thermo temperature counts no rigid-body DOF: use e.g.\n\
-     thermo_style    custom step atoms\n"
-        .to_owned()
 }
