@@ -636,6 +636,54 @@ pub(crate) fn liggghts_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec
         "fix pdd all particledistribution/discrete/numberbased 32452843 {n_used}{weights}"
     );
     files.push(("liggghts/templates.in".into(), script.into_bytes()));
+    let (_, b) = lammps_region(s.container)?;
+    let st = s.settle()?;
+    let m = s.material;
+    let mut check = s.header("#");
+    let _ = write!(
+        check,
+        r#"# LIGGGHTS: load the specimen's multisphere templates (run from this folder:
+#   liggghts -in in.templates, or ../shared/tools/liggghts-run liggghts/in.templates).
+# The contact constants of the other decks (Hertz, E = {es:e} Pa = quartz/{scale}, nu = {nu},
+# restitution {rest}, friction {mu}); no settling deck yet: LIGGGHTS-PUBLIC 3.8 inserts multisphere
+# bodies only at random positions of an insertion region (fix insert/pack into one tiny region per
+# body stops with "Unable to calculate region volume"), so the packed poses (../poses.csv) cannot be
+# given to it as they are.
+atom_style      granular
+atom_modify     map array
+boundary        f f f
+newton          off
+communicate     single vel yes
+units           si
+region          domain block {x0:e} {x1:e} {y0:e} {y1:e} {z0:e} {z1:e} units box
+create_box      1 domain
+neighbor        {skin:e} bin
+neigh_modify    delay 0
+fix             m1 all property/global youngsModulus peratomtype {es:e}
+fix             m2 all property/global poissonsRatio peratomtype {nu}
+fix             m3 all property/global coefficientRestitution peratomtypepair 1 {rest}
+fix             m4 all property/global coefficientFriction peratomtypepair 1 {mu}
+pair_style      gran model hertz tangential history
+pair_coeff      * *
+timestep        {dt:e}
+include         templates.in
+run             0
+"#,
+        es = m.youngs(),
+        scale = m.stiffness_scale,
+        nu = m.poisson_ratio,
+        rest = m.restitution,
+        mu = m.friction,
+        x0 = b[0][0],
+        x1 = b[0][1],
+        y0 = b[1][0],
+        y1 = b[1][1],
+        z0 = b[2][0],
+        z1 = b[2][1],
+        skin = 0.1 * st.d50,
+        dt = st.dt,
+    );
+    files.push(("liggghts/in.templates".into(), check.into_bytes()));
     Ok(files)
 }
 
@@ -712,9 +760,13 @@ mod tests {
                 && deck.contains("group           none empty")
         );
         let lig = liggghts_files(&s).expect("liggghts");
-        let script = String::from_utf8(lig.last().expect("script").1.clone()).expect("utf8");
+        let script = String::from_utf8(lig[1].1.clone()).expect("utf8");
         assert!(script.contains("numberbased") && script.contains("use_density mass"));
-        assert_eq!(lig.len(), 2, "one template for three bodies");
+        assert_eq!(
+            lig.len(),
+            3,
+            "one template for three bodies, templates.in, in.templates"
+        );
         let yade = yade_files(&s).expect("yade");
         assert!(
             String::from_utf8(yade[2].1.clone())
