@@ -689,7 +689,12 @@ run             0
 
 /// The smallest prime at least `n` (trial division; `n` is small).
 fn next_prime(mut n: u64) -> u64 {
-    let is_prime = |k: u64| k > 1 && (2..).take_while(|d| d * d <= k).all(|d| k % d != 0);
+    let is_prime = |k: u64| {
+        k > 1
+            && (2..)
+                .take_while(|d| d * d <= k)
+                .all(|d| !k.is_multiple_of(d))
+    };
     while !is_prime(n) {
         n += 1;
     }
@@ -738,7 +743,7 @@ mod tests {
         let st = s.settle().expect("settle");
         // Rayleigh: pi R sqrt(rho/G) / (0.1631 nu + 0.8766), R of the smallest clump
         let r = 0.5 * (6.0 * 8e-12 / std::f64::consts::PI).cbrt();
-        let g = 7e8 / 2.4;
+        let g: f64 = 7e8 / 2.4;
         let want = std::f64::consts::PI * r * (2650.0 / g).sqrt() / (0.1631 * 0.2 + 0.8766);
         approx::assert_relative_eq!(st.dt_rayleigh, want, max_relative = 1e-12);
         approx::assert_relative_eq!(st.dt, 0.2 * want, max_relative = 1e-12);

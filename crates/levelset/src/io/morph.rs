@@ -130,7 +130,7 @@ pub fn write_morph_decimals(mut w: impl Write, m: &MorphFile, decimals: u32) -> 
     let unit = 10i64.pow(decimals);
     let fixed = |s: &mut String, x: f64| -> Result<()> {
         let n = (x * scale).round();
-        if !(n.abs() < 9.2e18) {
+        if n.is_nan() || n.abs() >= 9.2e18 {
             return Err(Error::InvalidParameter {
                 name: "morph value (fixed notation)",
                 value: x,
