@@ -340,27 +340,34 @@ mod tests {
 
     #[test]
     fn overlaps_and_fractions_are_measured() {
-        let e = parse_settle("bodies 2\nspheres 3\nd50 1\nbox 0 0 0 10 10 10\n").expect("settle");
+        let e = parse_settle("bodies 3\nspheres 4\nd50 1\nbox 0 0 0 10 10 10\n").expect("settle");
+        // two bodies low in the box (body 1 of two overlapping spheres), a third high up
+        // setting the top of the bed (core region z in [1, 6])
         let a = vec![
             Ball {
                 body: 1,
-                c: Point3::new(5.0, 5.0, 5.0),
+                c: Point3::new(5.0, 5.0, 2.0),
                 r: 1.0,
             },
             Ball {
                 body: 1,
-                c: Point3::new(5.5, 5.0, 5.0),
+                c: Point3::new(5.5, 5.0, 2.0),
                 r: 1.0,
             },
             Ball {
                 body: 2,
-                c: Point3::new(7.0, 5.0, 5.0),
+                c: Point3::new(7.0, 5.0, 2.0),
+                r: 1.0,
+            },
+            Ball {
+                body: 3,
+                c: Point3::new(5.0, 5.0, 8.0),
                 r: 1.0,
             },
         ];
         let r = compare(&e, &a, &a).expect("compare");
         assert!((r.worst_overlap - 0.5).abs() < 1e-12, "{r:?}");
-        assert_eq!(r.bodies, 2);
+        assert_eq!(r.bodies, 3);
         assert!(r.fraction_before > 0.0 && r.fraction_before == r.fraction_after);
         let dump = "ITEM: TIMESTEP\n1\nITEM: ATOMS id mol x y z radius\n1 1 0 0 0 1\n2 2 3 0 0 1\n";
         assert_eq!(parse_dump(dump).expect("dump").len(), 2);
