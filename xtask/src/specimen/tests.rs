@@ -175,7 +175,10 @@ fn each_output_flag_changes_only_its_own_files() {
         .and_then(|l| l.split_whitespace().next())
         .and_then(|n| n.parse().ok())
         .expect("atom count");
-    let mols = data.split("\nMolecules\n").nth(1).expect("a Molecules section");
+    let mols = data
+        .split("\nMolecules\n")
+        .nth(1)
+        .expect("a Molecules section");
     assert_eq!(mols.lines().filter(|l| !l.trim().is_empty()).count(), atoms);
     let deck = std::fs::read_to_string(dir.join("flag-1/lammps/in.settle")).expect("deck");
     assert!(deck.contains("read_data       clumps.data fix mol NULL Molecules"));
