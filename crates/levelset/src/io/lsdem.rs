@@ -356,20 +356,8 @@ pub fn lsdem_matrix(q: [f64; 4]) -> Matrix3<f64> {
 ///
 /// # Errors
 /// [`Error::Io`] on write failure; [`Error::InvalidParameter`] for a non-finite coordinate.
-pub fn write_positions(mut w: impl Write, positions: &[Point3<f64>]) -> Result<()> {
-    let mut s = String::with_capacity(64 * positions.len());
-    for p in positions {
-        for (k, v) in p.coords.iter().enumerate() {
-            finite("position", *v)?;
-            if k > 0 {
-                s.push(' ');
-            }
-            super::fmt_f64(&mut s, *v);
-        }
-        s.push('\n');
-    }
-    w.write_all(s.as_bytes())?;
-    Ok(())
+pub fn write_positions(w: impl Write, positions: &[Point3<f64>]) -> Result<()> {
+    write_rows(w, "position", positions.iter().map(|p| [p.x, p.y, p.z]))
 }
 
 /// Writes `rotations_<NAME>.dat`: the [`lsdem_quaternion`] of each body → world rotation,
@@ -377,11 +365,20 @@ pub fn write_positions(mut w: impl Write, positions: &[Point3<f64>]) -> Result<(
 ///
 /// # Errors
 /// [`Error::Io`] on write failure; [`Error::InvalidParameter`] for a non-finite rotation.
-pub fn write_rotations(mut w: impl Write, rotations: &[UnitQuaternion<f64>]) -> Result<()> {
-    let mut s = String::with_capacity(96 * rotations.len());
-    for r in rotations {
-        for (k, v) in lsdem_quaternion(r).iter().enumerate() {
-            finite("rotation", *v)?;
+pub fn write_rotations(w: impl Write, rotations: &[UnitQuaternion<f64>]) -> Result<()> {
+    write_rows(w, "rotation", rotations.iter().map(lsdem_quaternion))
+}
+
+/// Rows of `N` finite numbers, space-separated, one per line.
+fn write_rows<const N: usize>(
+    mut w: impl Write,
+    name: &'static str,
+    rows: impl Iterator<Item = [f64; N]>,
+) -> Result<()> {
+    let mut s = String::new();
+    for row in rows {
+        for (k, v) in row.iter().enumerate() {
+            finite(name, *v)?;
             if k > 0 {
                 s.push(' ');
             }

@@ -81,31 +81,11 @@ impl MorphFile {
 ///
 /// # Errors
 /// [`Error::Io`] on write failure.
-pub fn write_morph(mut w: impl Write, m: &MorphFile) -> Result<()> {
-    let mut s = String::new();
-    let line = |s: &mut String, xs: &[f64]| {
-        for (i, &x) in xs.iter().enumerate() {
-            if i > 0 {
-                s.push(' ');
-            }
-            fmt_f64(s, x);
-        }
-        s.push('\n');
-    };
-    line(&mut s, &[m.mass]);
-    line(&mut s, m.principal_moments.as_slice());
-    line(&mut s, m.centroid.coords.as_slice());
-    s.push_str(&format!("{}\n", m.points.len()));
-    let flat: Vec<f64> = m.points.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
-    line(&mut s, &flat);
-    line(&mut s, &[m.bounding_radius]);
-    let d = m.grid.dims();
-    s.push_str(&format!("{} {} {}\n", d[0], d[1], d[2]));
-    w.write_all(s.as_bytes())?;
-    let mut s = String::new();
-    line(&mut s, m.grid.values());
-    w.write_all(s.as_bytes())?;
-    Ok(())
+pub fn write_morph(w: impl Write, m: &MorphFile) -> Result<()> {
+    write_morph_with(w, m, |s, x| {
+        fmt_f64(s, x);
+        Ok(())
+    })
 }
 
 /// Writes a morph file with the level-set values and the surface points in fixed notation
@@ -118,7 +98,7 @@ pub fn write_morph(mut w: impl Write, m: &MorphFile) -> Result<()> {
 /// # Errors
 /// [`Error::InvalidParameter`] for `decimals` above 12 or a value whose scaled magnitude
 /// does not fit an `i64` (|v| ≥ 9.2e18 / 10^decimals); [`Error::Io`] on write failure.
-pub fn write_morph_decimals(mut w: impl Write, m: &MorphFile, decimals: u32) -> Result<()> {
+pub fn write_morph_decimals(w: impl Write, m: &MorphFile, decimals: u32) -> Result<()> {
     if decimals > 12 {
         return Err(Error::InvalidParameter {
             name: "decimals",
@@ -127,8 +107,8 @@ pub fn write_morph_decimals(mut w: impl Write, m: &MorphFile, decimals: u32) -> 
         });
     }
     let scale = 10f64.powi(decimals as i32);
-    let unit = 10i64.pow(decimals);
-    let fixed = |s: &mut String, x: f64| -> Result<()> {
+    let unit = 10u64.pow(decimals);
+    write_morph_with(w, m, |s, x| {
         let n = (x * scale).round();
         if n.is_nan() || n.abs() >= 9.2e18 {
             return Err(Error::InvalidParameter {
@@ -142,13 +122,21 @@ pub fn write_morph_decimals(mut w: impl Write, m: &MorphFile, decimals: u32) -> 
             s.push('-');
         }
         let a = n.unsigned_abs();
-        let (int, frac) = (a / unit as u64, a % unit as u64);
-        let _ = write!(s, "{int}");
+        let _ = write!(s, "{}", a / unit);
         if decimals > 0 {
-            let _ = write!(s, ".{frac:0width$}", width = decimals as usize);
+            let _ = write!(s, ".{:0width$}", a % unit, width = decimals as usize);
         }
         Ok(())
-    };
+    })
+}
+
+/// The morph file layout, with the surface points and level-set values written by
+/// `number` (mass, moments, centroid and bounding radius: shortest round-trip).
+fn write_morph_with(
+    mut w: impl Write,
+    m: &MorphFile,
+    mut number: impl FnMut(&mut String, f64) -> Result<()>,
+) -> Result<()> {
     let mut s = String::new();
     let line = |s: &mut String, xs: &[f64]| {
         for (i, &x) in xs.iter().enumerate() {
@@ -159,31 +147,27 @@ pub fn write_morph_decimals(mut w: impl Write, m: &MorphFile, decimals: u32) -> 
         }
         s.push('\n');
     };
+    let mut numbers = |s: &mut String, xs: &mut dyn Iterator<Item = f64>| -> Result<()> {
+        for (i, x) in xs.enumerate() {
+            if i > 0 {
+                s.push(' ');
+            }
+            number(s, x)?;
+        }
+        s.push('\n');
+        Ok(())
+    };
     line(&mut s, &[m.mass]);
     line(&mut s, m.principal_moments.as_slice());
     line(&mut s, m.centroid.coords.as_slice());
     s.push_str(&format!("{}\n", m.points.len()));
-    for (i, p) in m.points.iter().enumerate() {
-        for (k, x) in p.coords.iter().enumerate() {
-            if i > 0 || k > 0 {
-                s.push(' ');
-            }
-            fixed(&mut s, *x)?;
-        }
-    }
-    s.push('\n');
+    numbers(&mut s, &mut m.points.iter().flat_map(|p| [p.x, p.y, p.z]))?;
     line(&mut s, &[m.bounding_radius]);
     let d = m.grid.dims();
     s.push_str(&format!("{} {} {}\n", d[0], d[1], d[2]));
     w.write_all(s.as_bytes())?;
     let mut s = String::with_capacity(14 * m.grid.values().len());
-    for (i, x) in m.grid.values().iter().enumerate() {
-        if i > 0 {
-            s.push(' ');
-        }
-        fixed(&mut s, *x)?;
-    }
-    s.push('\n');
+    numbers(&mut s, &mut m.grid.values().iter().copied())?;
     w.write_all(s.as_bytes())?;
     Ok(())
 }

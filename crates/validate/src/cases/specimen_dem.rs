@@ -33,7 +33,6 @@
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
-use cloner::{Calibrated, CloneModel, Hooks};
 use levelset::io::lsdem;
 use levelset::nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use levelset::{ClumpParams, Grid, clump, union_mass_properties};
@@ -43,7 +42,6 @@ use packer_quadtree::{
 };
 use rayon::prelude::*;
 
-use crate::fixtures;
 use crate::{Case, Check, Error, ExpectedFailure, Tolerance};
 
 pub(crate) fn cases() -> Vec<Case> {
@@ -137,21 +135,8 @@ struct Packed {
 
 /// `n` calibrated Ottawa clones packed at `fraction` in a cylinder H = 2D, with level sets.
 fn packed(n: u64, fraction: f64) -> Result<Packed, Error> {
-    let err = Error::computation;
-    let parents = crate::grains::ottawa_parents()?;
-    let mut cal = Calibrated::from_ron(fixtures::calibrated("gsc2-ottawa.ron")?).map_err(err)?;
-    cal.params.outputs.level_set = false;
-    cal.params.outputs.dna = false;
-    let model = CloneModel::fit(&parents, &cal.params).map_err(err)?;
-    let run = model.run(0..n, Hooks::default()).map_err(err)?;
-    let grains: Vec<StarGrain> = run
-        .clones
-        .par_iter()
-        .map(|c| {
-            let table = model.star_table(&c.radii, 16).map_err(err)?;
-            StarGrain::from_table(16, &table).map_err(Error::computation)
-        })
-        .collect::<Result<_, Error>>()?;
+    // the same clones as `specimen/cylinder-10k` (16 cube-map cells per face)
+    let grains = super::specimen::ottawa_star_grains(n)?;
     let container =
         container_for(&Container::triaxial(1.0), &grains, fraction).map_err(Error::computation)?;
     let packing = pack_grains(&grains, &container, &GrainPackParams::default())
