@@ -172,6 +172,8 @@ pub(crate) struct Settle {
     pub(crate) dt: f64,
     /// Rayleigh time step of the smallest clump, s.
     pub(crate) dt_rayleigh: f64,
+    /// Volume-equivalent radius of the smallest clump, m.
+    pub(crate) r_min: f64,
 }
 
 impl DemSpecimen<'_> {
@@ -210,6 +212,7 @@ impl DemSpecimen<'_> {
             ke_limit: 1e-6 * n as f64 * mean_mass * GRAVITY * d50,
             dt: 0.2 * dt_rayleigh,
             dt_rayleigh,
+            r_min,
         })
     }
 
@@ -285,8 +288,9 @@ fn lammps_region(c: &Container) -> anyhow::Result<(String, [[f64; 2]; 3])> {
     }
 }
 
-/// LAMMPS: `lammps/clumps.data` (atoms with a `Molecules` section: the body of each
-/// sphere), `lammps/bodies.rigid` (`fix rigid/small infile`: the union's mass, centre and
+/// LAMMPS: `lammps/clumps.data` (every sphere, plain `atom_style sphere`: LAMMPS'
+/// `read_data` alone reads it), `lammps/clumps.body` (the body of each sphere, an
+/// atomfile variable), `lammps/bodies.rigid` (`fix rigid/small infile`: the union's mass, centre and
 /// inertia tensor per body), `lammps/in.settle` (the deck).
 pub(crate) fn lammps_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
     let st = s.settle()?;
@@ -294,7 +298,7 @@ pub(crate) fn lammps_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u
     let mut data = String::new();
     let _ = writeln!(
         data,
-        "LAMMPS data file of grainforge (atom_style sphere, SI; read with `fix mol NULL Molecules`)\n"
+        "LAMMPS data file of grainforge (atom_style sphere, SI; the body of each atom: clumps.body)\n"
     );
     let _ = writeln!(data, "{} atoms\n1 atom types\n", st.atoms);
     for (b, axis) in bounds.iter().zip(["x", "y", "z"]) {
@@ -302,7 +306,12 @@ pub(crate) fn lammps_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u
     }
     let _ = writeln!(data, "\nAtoms # sphere\n");
     let mut id = 0usize;
-    let mut mols = String::new();
+    let mut mols = s.header("#");
+    let _ = writeln!(
+        mols,
+        "# body (molecule id) of every atom of clumps.data: atomfile-style variable of in.settle\n{}",
+        st.atoms
+    );
     for (k, b) in s.bodies.iter().enumerate() {
         for (c, r) in s.world(b) {
             id += 1;
@@ -318,7 +327,7 @@ pub(crate) fn lammps_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u
             let _ = writeln!(mols, "{id} {}", k + 1);
         }
     }
-    let _ = writeln!(data, "\nMolecules\n\n{mols}");
+
     let mut rigid = s.header("#");
     let _ = writeln!(
         rigid,
@@ -372,7 +381,9 @@ boundary        f f f
 comm_modify     vel yes
 newton          off
 fix             mol all property/atom mol ghost yes
-read_data       clumps.data fix mol NULL Molecules
+read_data       clumps.data
+variable        body atomfile clumps.body
+set             group all mol v_body
 neighbor        {skin:e} bin
 neigh_modify    delay 0 every 1 check yes exclude molecule/intra all
 pair_style      granular
@@ -410,8 +421,7 @@ write_dump      all custom final.dump id mol x y z radius modify sort id format 
         nu = m.poisson_ratio,
         mu = m.friction,
         rest = m.restitution,
-        rmin = st.dt_rayleigh * (0.1631 * m.poisson_ratio + 0.8766)
-            / (std::f64::consts::PI * (s.density / m.shear()).sqrt()),
+        rmin = st.r_min,
         dtr = st.dt_rayleigh,
         ke = st.ke_limit,
         n = st.n,
@@ -429,6 +439,7 @@ write_dump      all custom final.dump id mol x y z radius modify sort id format 
             super::check::settle_text(st.n, st.atoms, st.d50, s.container).into_bytes(),
         ),
         ("lammps/clumps.data".into(), data.into_bytes()),
+        ("lammps/clumps.body".into(), mols.into_bytes()),
         ("lammps/bodies.rigid".into(), rigid.into_bytes()),
         ("lammps/in.settle".into(), deck.into_bytes()),
     ])
@@ -748,7 +759,7 @@ mod tests {
         approx::assert_relative_eq!(st.dt_rayleigh, want, max_relative = 1e-12);
         approx::assert_relative_eq!(st.dt, 0.2 * want, max_relative = 1e-12);
         let files = lammps_files(&s).expect("lammps");
-        let rigid = String::from_utf8(files[2].1.clone()).expect("utf8");
+        let rigid = String::from_utf8(files[3].1.clone()).expect("utf8");
         // one line per body with the union's mass 2650 * 8e-12
         let body: Vec<&str> = rigid.lines().filter(|l| l.starts_with("1 ")).collect();
         assert_eq!(body.len(), 1);
@@ -759,7 +770,7 @@ mod tests {
             .parse()
             .expect("f64");
         approx::assert_relative_eq!(mass, 2650.0 * 8e-12, max_relative = 1e-12);
-        let deck = String::from_utf8(files[3].1.clone()).expect("utf8");
+        let deck = String::from_utf8(files[4].1.clone()).expect("utf8");
         assert!(
             deck.contains("infile bodies.rigid gravity grav")
                 && deck.contains("group           none empty")

@@ -154,7 +154,7 @@ fn each_output_flag_changes_only_its_own_files() {
         .filter_map(|l| l.split_whitespace().last().map(String::from))
         .collect();
     assert_eq!(spacings.len(), 1, "{spacings:?}");
-    // LAMMPS: one rigid-body line per grain (the union's mass > 0), a Molecules section
+    // LAMMPS: one rigid-body line per grain (the union's mass > 0), a body file
     // naming a body for every atom, and the deck
     let rigid = std::fs::read_to_string(dir.join("flag-1/lammps/bodies.rigid")).expect("rigid");
     let lines: Vec<&str> = rigid.lines().filter(|l| !l.starts_with('#')).collect();
@@ -175,13 +175,12 @@ fn each_output_flag_changes_only_its_own_files() {
         .and_then(|l| l.split_whitespace().next())
         .and_then(|n| n.parse().ok())
         .expect("atom count");
-    let mols = data
-        .split("\nMolecules\n")
-        .nth(1)
-        .expect("a Molecules section");
-    assert_eq!(mols.lines().filter(|l| !l.trim().is_empty()).count(), atoms);
+    let body = std::fs::read_to_string(dir.join("flag-1/lammps/clumps.body")).expect("body");
+    let rows: Vec<&str> = body.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(rows[0].trim().parse::<usize>().expect("count"), atoms);
+    assert_eq!(rows.len(), atoms + 1);
     let deck = std::fs::read_to_string(dir.join("flag-1/lammps/in.settle")).expect("deck");
-    assert!(deck.contains("read_data       clumps.data fix mol NULL Molecules"));
+    assert!(deck.contains("set             group all mol v_body"));
     let vtu = std::fs::read_to_string(dir.join("flag-4/specimen.vtu")).expect("vtu");
     assert!(vtu.contains("grain_id") && vtu.trim_end().ends_with("</VTKFile>"));
     assert!(vtu.contains(r#"header_type="UInt64""#) && !vtu.contains(r#"format="ascii""#));
