@@ -28,6 +28,7 @@ use packer_quadtree::{Container, Sphere, StarGrain};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
+mod dem;
 mod estimate;
 mod outputs;
 mod place;
@@ -788,44 +789,85 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         }
     }
     let container_m = scale_container(&container, metres);
-    match need(out.lammps_clumps, "LAMMPS clumps") {
-        Some(r) => st.skip("lammps", &r),
-        None => {
-            let t = Instant::now();
-            let (data, body) = outputs::lammps_clumps(&clumps, &container_m, out.density)?;
-            staging.write("lammps/clumps.data", &data)?;
-            staging.write("lammps/clumps.body", body.as_bytes())?;
-            staging.write("lammps/in.clumps", lammps_input().as_bytes())?;
-            st.ran(
-                "lammps",
-                t,
-                "lammps/clumps.data + clumps.body + in.clumps".into(),
-            );
-        }
+    // DEM decks. GLUE (to be replaced by the scene keys): one template per distinct shape as
+    // the clumps stage made it, the scene's density and the default contact constants.
+    let material = dem::Material {
+        density: out.density,
+        ..dem::Material::default()
+    };
+    let mut dem_templates: Vec<Option<dem::Template>> = vec![None; n_templates];
+    for c in &clumps {
+        dem_templates[c.template].get_or_insert_with(|| dem::Template {
+            spheres: c.spheres.clone(),
+            volume: c.volume,
+            centroid: c.centroid,
+            inertia: c.inertia,
+        });
     }
-    match need(out.liggghts_templates, "LIGGGHTS templates") {
-        Some(r) => st.skip("liggghts", &r),
-        None => {
-            let t = Instant::now();
-            let (files, script) = outputs::liggghts_templates(&clumps, out.density);
-            for (name, text) in &files {
-                staging.write(&format!("liggghts/{name}"), text.as_bytes())?;
+    let dem_templates: Vec<dem::Template> = dem_templates
+        .into_iter()
+        .map(|t| {
+            t.unwrap_or_else(|| dem::Template {
+                spheres: Vec::new(),
+                volume: f64::NAN,
+                centroid: Point3::origin(),
+                inertia: nalgebra::Matrix3::zeros(),
+            })
+        })
+        .collect();
+    let dem_bodies: Vec<dem::Body> = clumps
+        .iter()
+        .map(|c| dem::Body {
+            id: c.index,
+            template: c.template,
+            pose: c.pose,
+        })
+        .collect();
+    let dem_spec = dem::DemSpecimen {
+        templates: &dem_templates,
+        bodies: &dem_bodies,
+        container: &container_m,
+        material: &material,
+        provenance: &provenance,
+    };
+    // end of GLUE
+    for (name, on, what, write) in [
+        (
+            "lammps",
+            out.lammps_clumps,
+            "LAMMPS clumps",
+            dem::lammps_files as fn(&dem::DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u8>)>>,
+        ),
+        (
+            "liggghts",
+            out.liggghts_templates,
+            "LIGGGHTS templates",
+            dem::liggghts_files,
+        ),
+        ("yade", out.yade_clumps, "Yade clumps", dem::yade_files),
+    ] {
+        match need(on, what) {
+            Some(r) => st.skip(name, &r),
+            None => {
+                let t = Instant::now();
+                let files = write(&dem_spec).with_context(|| format!("{name} deck"))?;
+                for (path, bytes) in &files {
+                    staging.write(path, bytes)?;
+                }
+                let plan = dem_spec.plan()?;
+                st.ran(
+                    name,
+                    t,
+                    format!(
+                        "{} files: a settle deck with its checks ({} bodies, dt {:.3e} s, at most {} steps; packed bed fraction {:.4})",
+                        files.len(),
+                        plan.n,
+                        plan.dt,
+                        plan.max_steps,
+                        plan.packed_fraction
+                    ),
+                );
             }
-            staging.write("liggghts/templates.in", script.as_bytes())?;
-            st.ran(
-                "liggghts",
-                t,
-                format!("{} templates + liggghts/templates.in", files.len()),
-            );
-        }
-    }
-    match need(out.yade_clumps, "Yade clumps") {
-        Some(r) => st.skip("yade", &r),
-        None => {
-            let t = Instant::now();
-            staging.write("yade/clumps.txt", outputs::yade_clumps(&clumps).as_bytes())?;
-            staging.write("yade/load_clumps.py", outputs::YADE_SCRIPT.as_bytes())?;
-            st.ran("yade", t, "yade/clumps.txt + load_clumps.py".into());
         }
     }
     match need(out.vtu, "VTU") {
@@ -1209,30 +1251,4 @@ fn fixed_container(spec: &ContainerSpec) -> Container {
         // sized by the caller
         ContainerSpec::AutoCylinder { .. } => Container::triaxial(1.0),
     }
-}
-
-/// `lammps/in.clumps`: the LAMMPS lines that read the clumps as rigid
-/// bodies (checked with LAMMPS 2024+: `2 rigid bodies with 4 atoms` on a
-/// small case; the body ids become molecule ids so that the overlapping
-/// spheres of one body do not interact).
-fn lammps_input() -> String {
-    "# grainforge specimen: read the clumps into LAMMPS as rigid bodies (run from out_dir/lammps).\n\
-     # Contact model, walls, gravity, thermo output and time step are yours; these lines load the specimen.\n\
-     units           si\n\
-     dimension       3\n\
-     atom_style      sphere\n\
-     atom_modify     map array   # atomfile variables need an atom map\n\
-     boundary        f f f\n\
-     comm_modify     vel yes\n\
-     read_data       clumps.data\n\
-     variable        body atomfile clumps.body\n\
-     # body ids as molecule ids: spheres of one body overlap, so exclude their pairs\n\
-     fix             mol all property/atom mol ghost yes\n\
-     set             group all mol v_body\n\
-     neigh_modify    exclude molecule/intra all\n\
-     fix             clumps all rigid/small molecule\n\
-     # (without the exclusion: fix clumps all rigid/small custom v_body)\n\
-     # the default thermo temperature counts no rigid-body DOF: use e.g.\n\
-     thermo_style    custom step atoms\n"
-        .to_owned()
 }

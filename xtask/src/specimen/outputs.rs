@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::Context;
 use nalgebra::{Isometry3, Point3};
-use packer_quadtree::{Container, Sphere};
+
 
 /// A hidden folder beside `out_dir` collecting the run's files.
 pub(crate) struct Staging {
@@ -253,118 +253,6 @@ pub(crate) struct PlacedClump {
     pub(crate) centroid: Point3<f64>,
     #[allow(dead_code)]
     pub(crate) inertia: nalgebra::Matrix3<f64>,
-}
-
-impl PlacedClump {
-    fn world(&self) -> impl Iterator<Item = Sphere> + '_ {
-        self.spheres.iter().map(|(c, r)| Sphere {
-            center: self.pose * c,
-            radius: *r,
-        })
-    }
-}
-
-/// `lammps/clumps.data` (every clump sphere, `atom_style sphere`) and
-/// `lammps/clumps.body` (an atomfile-style variable: atom id → body id).
-pub(crate) fn lammps_clumps(
-    clumps: &[PlacedClump],
-    container: &Container,
-    density: f64,
-) -> anyhow::Result<(Vec<u8>, String)> {
-    let spheres: Vec<Sphere> = clumps.iter().flat_map(PlacedClump::world).collect();
-    let mut data = Vec::new();
-    packer_quadtree::write_lammps_data3(&spheres, container, density, &mut data)?;
-    let mut body = String::from(
-        "# grainforge specimen: body id of every atom of clumps.data (atomfile-style variable)\n\
-         # LAMMPS (see in.clumps): atom_modify map array; read_data clumps.data;\n\
-         #   variable body atomfile clumps.body; fix clumps all rigid/small custom v_body\n",
-    );
-    let _ = writeln!(body, "{}", spheres.len());
-    let mut id = 0usize;
-    for (b, c) in clumps.iter().enumerate() {
-        for _ in &c.spheres {
-            id += 1;
-            let _ = writeln!(body, "{id} {}", b + 1);
-        }
-    }
-    Ok((data, body))
-}
-
-/// `yade/clumps.txt`: `x y z r clump_id` per sphere (world frame).
-pub(crate) fn yade_clumps(clumps: &[PlacedClump]) -> String {
-    let mut s = String::from("# grainforge specimen: x y z r clump_id (world frame)\n");
-    for (b, c) in clumps.iter().enumerate() {
-        for sp in c.world() {
-            let _ = writeln!(
-                s,
-                "{:e} {:e} {:e} {:e} {b}",
-                sp.center.x, sp.center.y, sp.center.z, sp.radius
-            );
-        }
-    }
-    s
-}
-
-/// `yade/load_clumps.py`: reads `clumps.txt` into clumps.
-pub(crate) const YADE_SCRIPT: &str = r#"# grainforge specimen: load the clumps of clumps.txt into Yade.
-# Run inside Yade (e.g. `yade load_clumps.py`, or exec(open('load_clumps.py').read())
-# from your own script, after defining materials).
-import os
-from yade import utils
-
-here = os.path.dirname(os.path.abspath(__file__)) if '__file__' in globals() else '.'
-clumps = {}
-with open(os.path.join(here, 'clumps.txt')) as f:
-    for line in f:
-        if line.startswith('#') or not line.strip():
-            continue
-        x, y, z, r, c = line.split()
-        clumps.setdefault(int(c), []).append(((float(x), float(y), float(z)), float(r)))
-for c in sorted(clumps):
-    O.bodies.appendClumped([utils.sphere(centre, radius) for centre, radius in clumps[c]])
-print('grainforge: %d clumps loaded' % len(clumps))
-"#;
-
-/// LIGGGHTS templates: one `liggghts/clump-NNNNNN.txt` per clone (`x y z r`
-/// per sphere, clone frame) and `liggghts/templates.in` with the
-/// `particletemplate/multisphere` fixes and a discrete distribution of
-/// them (equal weights).
-pub(crate) fn liggghts_templates(
-    clumps: &[PlacedClump],
-    density: f64,
-) -> (Vec<(String, String)>, String) {
-    let mut files = Vec::new();
-    let mut script = String::from(
-        "# grainforge specimen: LIGGGHTS multisphere templates, one per clone.\n\
-         # include this file from the LIGGGHTS input (paths are relative to out_dir/liggghts);\n\
-         # density = the scene's `outputs.density`; one multisphere type per template.\n\
-         # The placed poses are in ../poses.csv.\n",
-    );
-    let n = clumps.len();
-    for (k, c) in clumps.iter().enumerate() {
-        let name = format!("clump-{:06}.txt", c.index);
-        let mut t = String::new();
-        for (p, r) in &c.spheres {
-            let _ = writeln!(t, "{:e} {:e} {:e} {:e}", p.x, p.y, p.z, r);
-        }
-        let _ = writeln!(
-            script,
-            "fix pts{} all particletemplate/multisphere 15485863 atom_type 1 density constant {density} nspheres {} ntry 1000000 spheres file {name} scale 1.0 type {}",
-            k + 1,
-            c.spheres.len(),
-            k + 1
-        );
-        files.push((name, t));
-    }
-    let _ = write!(
-        script,
-        "fix pdd all particledistribution/discrete 32452843 {n}"
-    );
-    for k in 0..n {
-        let _ = write!(script, " &\n    pts{} {:.12}", k + 1, 1.0 / n as f64);
-    }
-    script.push('\n');
-    (files, script)
 }
 
 /// A streaming VTU (UnstructuredGrid, VTK XML with inline binary data) of
