@@ -22,8 +22,8 @@
 //! `fix gravity` on the atoms would weigh the summed sphere masses); Yade
 //! `appendClumped(…, discretization=…)` (Yade integrates the union on a grid; the deck
 //! prints its masses against the union's); LIGGGHTS `particletemplate/multisphere` with the
-//! union's `mass`, `volume_mc` and `inertia_tensor`, its sphere centres relative to the
-//! union's centroid.
+//! union's `mass` (`use_density`: volume = mass / density) and `inertia_tensor`, its sphere
+//! centres relative to the union's centroid (the template's centre of mass).
 //!
 //! # Time step (Hertz criterion, smallest clump)
 //! The Hertz contact duration of the lightest clump against its copy, at the smallest
@@ -37,8 +37,8 @@
 //!
 //! # Settling and the checks
 //! The deck runs in chunks of [`Plan::chunk`] steps, at least [`Plan::min_steps`] (two
-//! free-fall times over the largest diameter) and at most [`Plan::max_steps`] (ten free-fall
-//! times over the bed height), and stops when the kinetic energy of the bodies (translation
+//! free-fall times over the largest diameter) and at most [`Plan::max_steps`] (five free-fall
+//! times over the container height), and stops when the kinetic energy of the bodies (translation
 //! and rotation) is at most `1e-6 · N · m̄ · g · d50` (`m̄` the mean body mass, `d50` the
 //! median volume-equivalent diameter). Then it checks: every body present; that energy; the
 //! largest overlap of two spheres of different bodies ≤ 1 % of d50; and the bed's solid
@@ -395,7 +395,7 @@ impl DemSpecimen<'_> {
             v_impact,
             chunk: CHUNK_STEPS,
             min_steps: steps(2.0 * fall(d_max)),
-            max_steps: steps(10.0 * fall(height(self.container).max(d_max))),
+            max_steps: steps(5.0 * fall(height(self.container).max(d_max))),
             volume,
             floor,
             area,
@@ -637,6 +637,8 @@ write_restart   settled.restart
 write_dump      all custom final.dump id mol x y z radius modify sort id
 # largest overlap of two spheres of different bodies, by bisection: shrink every radius by s/2
 # (pairs of one body stay excluded) and see whether any pair still touches
+uncompute       ket
+uncompute       ker
 unfix           bodies
 unfix           walls
 fix             r0 all store/state 0 radius
@@ -662,7 +664,8 @@ print           "grainforge settle: bed fraction ${{phistart}} -> ${{phiend}} (p
 if              "$(atoms) != {atoms}" then "print 'grainforge settle: FAILED, atoms lost'" "quit 1"
 if              "${{kefinal}} > ${{limit}}" then "print 'grainforge settle: FAILED, not at rest after {max} steps'" "quit 1"
 if              "${{overlap}} > {ovm:e}" then "print 'grainforge settle: FAILED, overlap above {ovl} d50'" "quit 1"
-if              "abs(${{phiend}}-${{phi0}}) > {ft}" then "print 'grainforge settle: FAILED, bed fraction moved more than {ft}'" "quit 1"
+variable        dphi equal abs(${{phiend}}-${{phi0}})
+if              "${{dphi}} > {ft}" then "print 'grainforge settle: FAILED, bed fraction moved more than {ft}'" "quit 1"
 print           "grainforge settle: OK"
 "#,
         skin = 0.1 * p.d50,
@@ -918,6 +921,7 @@ pub(crate) fn liggghts_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec
         .iter()
         .zip(&used)
         .any(|(t, u)| *u > 0 && t.spheres.len() > 1);
+    let mut ms_type = 0usize;
     for (k, t) in s.templates.iter().enumerate() {
         if used[k] == 0 {
             continue;
@@ -926,7 +930,7 @@ pub(crate) fn liggghts_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec
         if t.spheres.len() == 1 {
             let _ = writeln!(
                 tpl,
-                "fix             pts{k1} all particletemplate/sphere {} atom_type 1 density constant {:e} radius constant {:e}",
+                "fix             pts{k1} all particletemplate/sphere {} atom_type 1 volume_limit 1e-30 density constant {:e} radius constant {:e}",
                 next_seed(),
                 m.density,
                 t.spheres[0].1
@@ -939,15 +943,16 @@ pub(crate) fn liggghts_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec
                 let _ = writeln!(text, "{:e} {:e} {:e} {:e}", d.x, d.y, d.z, r);
             }
             files.push((format!("liggghts/{name}"), text.into_bytes()));
+            // multisphere types are consecutive from 1
+            ms_type += 1;
             let i = t.inertia * m.density;
             let _ = writeln!(
                 tpl,
-                "fix             pts{k1} all particletemplate/multisphere {} atom_type 1 density constant {:e} nspheres {} ntry 100000 spheres file {name} scale 1.0 type {k1} mass {:e} volume_mc {:e} inertia_tensor {:e} {:e} {:e} {:e} {:e} {:e}",
+                "fix             pts{k1} all particletemplate/multisphere {} atom_type 1 volume_limit 1e-30 density constant {:e} nspheres {} ntry 100000 spheres file {name} scale 1.0 type {ms_type} mass {:e} use_density inertia_tensor {:e} {:e} {:e} {:e} {:e} {:e}",
                 next_seed(),
                 m.density,
                 t.spheres.len(),
                 t.volume * m.density,
-                t.volume,
                 i[(0, 0)],
                 i[(0, 1)],
                 i[(0, 2)],
@@ -977,7 +982,7 @@ pub(crate) fn liggghts_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec
         };
         let _ = writeln!(
             ins,
-            "region          r{k1} sphere {:e} {:e} {:e} {tiny:e} units box\n\
+            "region          r{k1} sphere {:e} {:e} {:e} {tiny:e} units box volume_limit 1e-30\n\
              fix             ins{k1} {group} insert/pack seed {} distributiontemplate pdd{} insert_every once overlapcheck no orientation constant {:.15} {:.15} {:.15} {:.15} region r{k1} particles_in_region 1",
             c.x,
             c.y,
@@ -1056,12 +1061,12 @@ pair_coeff      * *
 timestep        {dt:e}
 {walls}
 fix             gravi all gravity {g} vector 0.0 0.0 -1.0
-group           singles empty
+group           singles type 1
+compute         pgl all pair/gran/local delta
 {tpl}{ms}{nve}{ins}run             1
 {unfix}compute         zs all reduce ave z
 variable        phi equal {vol:e}/({area:e}*2*(c_zs-({floor:e})))
-{ke_computes}compute         pgl all pair/gran/local delta
-compute         ovl all reduce max c_pgl
+{ke_computes}compute         ovl all reduce max c_pgl[1]
 thermo_style    custom step time atoms v_ke v_phi
 thermo          {chunk}
 thermo_modify   lost error norm no
