@@ -1041,7 +1041,8 @@ pub(crate) fn liggghts_files(s: &DemSpecimen) -> anyhow::Result<Vec<(String, Vec
         deck,
         r#"# Bodies start at their packed poses: insert/pack of one particle in a sphere of radius {tiny:e} m
 # around each centre of mass, orientation constant = the pose's quaternion (w x y z); templates
-# shared by several bodies are defined once; distributions are numberbased.
+# shared by several bodies are defined once; distributions are numberbased. A failed check jumps
+# to a label that does not exist: LIGGGHTS stops with an ERROR (its `quit` exits 0).
 atom_style      granular
 atom_modify     map array
 boundary        f f f
@@ -1083,6 +1084,8 @@ if              "${{ke}} <= ${{limit}}" then "jump SELF settled"
 next            chunk
 jump            SELF settle
 label           settled
+# computes are current only on output steps: one more evaluation step
+run             0
 variable        kefinal equal {kefinal}
 variable        phiend equal {phiend}
 variable        overlap equal {overlap}
@@ -1091,11 +1094,11 @@ print           "grainforge settle: atoms {atoms_now} of {atoms} ({n} bodies), k
 print           "grainforge settle: largest overlap ${{overlap}} m (limit {ovm:e} m = {ovl} d50)"
 print           "grainforge settle: bed fraction ${{phistart}} -> ${{phiend}} (packed {pf:.6}, tolerance {ft})"
 variable        nat equal atoms
-if              "${{nat}} != {atoms}" then "print 'grainforge settle: FAILED, atoms lost'" "quit"
-if              "${{kefinal}} > ${{limit}}" then "print 'grainforge settle: FAILED, not at rest after {max} steps'" "quit"
-if              "${{overlap}} > {ovm:e}" then "print 'grainforge settle: FAILED, overlap above {ovl} d50'" "quit"
+if              "${{nat}} != {atoms}" then "print 'grainforge settle: FAILED, atoms lost'" "jump SELF grainforge_settle_failed"
+if              "${{kefinal}} > ${{limit}}" then "print 'grainforge settle: FAILED, not at rest after {max} steps'" "jump SELF grainforge_settle_failed"
+if              "${{overlap}} > {ovm:e}" then "print 'grainforge settle: FAILED, overlap above {ovl} d50'" "jump SELF grainforge_settle_failed"
 variable        dphi equal abs(${{phiend}}-${{phi0}})
-if              "${{dphi}} > {ft}" then "print 'grainforge settle: FAILED, bed fraction moved more than {ft}'" "quit"
+if              "${{dphi}} > {ft}" then "print 'grainforge settle: FAILED, bed fraction moved more than {ft}'" "jump SELF grainforge_settle_failed"
 print           "grainforge settle: OK"
 "#,
         bounds[0][0],
@@ -1121,10 +1124,10 @@ print           "grainforge settle: OK"
         } else {
             ""
         },
-        ke_computes = if multi {
-            "compute         ket all ke/multisphere\ncompute         ker all erotate/multisphere\nvariable        ke equal c_ket+c_ker\n"
-        } else {
-            "compute         ket all ke\ncompute         ker all erotate/sphere\nvariable        ke equal c_ket+c_ker\n"
+        ke_computes = match (multi, singles) {
+            (true, false) => "compute         ket all ke/multisphere\ncompute         ker all erotate/multisphere\nvariable        ke equal c_ket+c_ker\n",
+            (true, true) => "compute         ket all ke/multisphere\ncompute         ker all erotate/multisphere\ncompute         kes singles ke\ncompute         kers singles erotate/sphere\nvariable        ke equal c_ket+c_ker+c_kes+c_kers\n",
+            _ => "compute         ket all ke\ncompute         ker all erotate/sphere\nvariable        ke equal c_ket+c_ker\n",
         },
         vol = p.volume,
         area = p.area,
