@@ -826,7 +826,7 @@ while True:
         break
     O.run({chunk}, True)
 O.save('settled.yade.gz')
-n = len([b for b in bodies if bodies[b] in O.bodies and O.bodies[bodies[b]] is not None])
+n = sum(1 for b in bodies if O.bodies[bodies[b]] is not None)
 overlap = largest_overlap()
 phi_end = bed_fraction()
 print('grainforge settle: bodies %d of {n}, kinetic energy %.4e J (limit %.4e J) at step %d, t = %.6g s' % (n, ke, limit, O.iter, O.time))
@@ -1084,7 +1084,8 @@ if              "${{ke}} <= ${{limit}}" then "jump SELF settled"
 next            chunk
 jump            SELF settle
 label           settled
-# computes are current only on output steps: one more evaluation step
+# computes are current only on output steps: one more step that outputs them all
+thermo_style    custom step atoms v_ke v_phi c_ovl
 run             0
 variable        kefinal equal {kefinal}
 variable        phiend equal {phiend}
@@ -1125,9 +1126,12 @@ print           "grainforge settle: OK"
             ""
         },
         ke_computes = match (multi, singles) {
-            (true, false) => "compute         ket all ke/multisphere\ncompute         ker all erotate/multisphere\nvariable        ke equal c_ket+c_ker\n",
-            (true, true) => "compute         ket all ke/multisphere\ncompute         ker all erotate/multisphere\ncompute         kes singles ke\ncompute         kers singles erotate/sphere\nvariable        ke equal c_ket+c_ker+c_kes+c_kers\n",
-            _ => "compute         ket all ke\ncompute         ker all erotate/sphere\nvariable        ke equal c_ket+c_ker\n",
+            (true, false) =>
+                "compute         ket all ke/multisphere\ncompute         ker all erotate/multisphere\nvariable        ke equal c_ket+c_ker\n",
+            (true, true) =>
+                "compute         ket all ke/multisphere\ncompute         ker all erotate/multisphere\ncompute         kes singles ke\ncompute         kers singles erotate/sphere\nvariable        ke equal c_ket+c_ker+c_kes+c_kers\n",
+            _ =>
+                "compute         ket all ke\ncompute         ker all erotate/sphere\nvariable        ke equal c_ket+c_ker\n",
         },
         vol = p.volume,
         area = p.area,
@@ -1261,7 +1265,8 @@ mod tests {
             2.0 * 4.0 / 3.0 * PI * r.powi(3) - lens,
             max_relative = 3e-3
         );
-        assert!(summed_volume(&t) / t.volume > 1.3);
+        // the lens is 15.6 % of a sphere: the sum over-counts by 18 %
+        assert!(summed_volume(&t) / t.volume > 1.15);
         assert_relative_eq!(centroid_offset(&t).norm(), 0.0, epsilon = 1e-3 * r);
         // the body mass the decks give is the union's
         let b = bodies(1, 1);
@@ -1423,7 +1428,12 @@ mod tests {
         assert!(deck.contains("discretization=DISCRETIZATION"));
         assert!(deck.contains("raise SystemExit(1)"));
         assert!(deck.contains("O.save('settled.yade.gz')"));
-        assert!(!deck.contains("__file__ ") && !deck.contains("os.path.dirname"));
+        // the files are read from the current folder, never through __file__
+        assert!(
+            deck.lines()
+                .all(|l| l.starts_with('#') || !l.contains("__file__"))
+        );
+        assert!(deck.contains("open('clumps.txt')"));
         // a one-sphere body is a plain sphere
         assert!(deck.contains("if len(ss) == 1:"));
     }
@@ -1440,8 +1450,11 @@ mod tests {
                 .count(),
             2
         );
-        assert_eq!(deck.matches(" insert/pack ").count(), 4);
-        assert_eq!(deck.matches("orientation constant").count(), 4);
+        assert_eq!(deck.matches(" insert/pack seed").count(), 4);
+        assert_eq!(
+            deck.matches("overlapcheck no orientation constant").count(),
+            4
+        );
         assert!(deck.contains("fix             integr singles nve/sphere"));
         assert!(deck.contains("fix             ms all multisphere"));
         // template spheres relative to the union centroid

@@ -16,7 +16,6 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use anyhow::Context;
 use nalgebra::{Isometry3, Point3};
 
-
 /// A hidden folder beside `out_dir` collecting the run's files.
 pub(crate) struct Staging {
     dir: PathBuf,
