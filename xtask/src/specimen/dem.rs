@@ -1472,14 +1472,32 @@ mod tests {
             t.spheres[0].0.x - t.centroid.x,
             max_relative = 1e-12
         );
-        // seeds are primes above 1e4
-        for w in deck.split_whitespace().filter(|w| w.len() == 6) {
-            if let Ok(v) = w.parse::<u64>()
-                && v > 100_000
-            {
-                assert!((2..).take_while(|d| d * d <= v).all(|d| v % d != 0), "{v}");
+        // seeds (the word after these keywords) are distinct primes above 1e4
+        let mut seeds = Vec::new();
+        for l in deck.lines() {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            for (k, word) in w.iter().enumerate() {
+                if matches!(
+                    *word,
+                    "particletemplate/multisphere"
+                        | "particletemplate/sphere"
+                        | "particledistribution/discrete/numberbased"
+                        | "seed"
+                ) {
+                    seeds.push(w[k + 1].parse::<u64>().expect("seed"));
+                }
             }
         }
+        assert_eq!(seeds.len(), 2 + 2 + 4);
+        for v in &seeds {
+            assert!(
+                *v > 10_000 && (2..).take_while(|d| d * d <= *v).all(|d| v % d != 0),
+                "{v}"
+            );
+        }
+        seeds.sort_unstable();
+        seeds.dedup();
+        assert_eq!(seeds.len(), 8);
         assert!(!deck.contains("{{") && !deck.contains("}}"));
     }
 
