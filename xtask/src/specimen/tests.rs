@@ -154,17 +154,27 @@ fn each_output_flag_changes_only_its_own_files() {
         .filter_map(|l| l.split_whitespace().last().map(String::from))
         .collect();
     assert_eq!(spacings.len(), 1, "{spacings:?}");
-    let body = std::fs::read_to_string(dir.join("flag-1/lammps/clumps.body")).expect("body");
-    let data = packer_quadtree::read_lammps_data3(std::io::BufReader::new(
-        std::fs::File::open(dir.join("flag-1/lammps/clumps.data")).expect("data"),
-    ))
-    .expect("the data file reads back");
-    let n_body: usize = body
+    // the LAMMPS deck: one rigid-body line per grain, every clump sphere in the data file
+    let rigid = std::fs::read_to_string(dir.join("flag-1/lammps/bodies.rigid")).expect("rigid");
+    let n_body: usize = rigid
         .lines()
         .find(|l| !l.starts_with('#'))
         .and_then(|l| l.trim().parse().ok())
         .expect("count line");
-    assert_eq!(n_body, data.spheres.len());
+    assert_eq!(n_body, 20);
+    let data = std::fs::read_to_string(dir.join("flag-1/lammps/clumps.data")).expect("data");
+    let atoms: usize = data
+        .lines()
+        .find_map(|l| l.strip_suffix(" atoms"))
+        .and_then(|n| n.trim().parse().ok())
+        .expect("atoms line");
+    let molecules = data.split("Molecules\n\n").nth(1).expect("Molecules");
+    assert_eq!(molecules.lines().count(), atoms);
+    assert!(
+        std::fs::read_to_string(dir.join("flag-1/lammps/in.settle"))
+            .expect("deck")
+            .contains("rigid/small molecule infile bodies.rigid")
+    );
     let vtu = std::fs::read_to_string(dir.join("flag-4/specimen.vtu")).expect("vtu");
     assert!(vtu.contains("grain_id") && vtu.trim_end().ends_with("</VTKFile>"));
     assert!(vtu.contains(r#"header_type="UInt64""#) && !vtu.contains(r#"format="ascii""#));
