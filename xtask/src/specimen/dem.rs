@@ -658,7 +658,7 @@ if              "$(c_ntouch) > 0" then "variable lo equal $(v_s)" else "variable
 next            bis
 jump            SELF bisect
 variable        overlap equal ${{hi}}
-print           "grainforge settle: bodies $(atoms) atoms of {atoms} ({n} bodies), kinetic energy ${{kefinal}} J (limit ${{limit}} J) at step $(step), t = $(time) s"
+print           "grainforge settle: atoms $(atoms) of {atoms} ({n} bodies), kinetic energy ${{kefinal}} J (limit ${{limit}} J) at step $(step), t = $(time) s"
 print           "grainforge settle: largest overlap ${{overlap}} m = $(v_overlap/{d50:e}) d50 (limit {ovl})"
 print           "grainforge settle: bed fraction ${{phistart}} -> ${{phiend}} (packed {pf:.6}, tolerance {ft})"
 if              "$(atoms) != {atoms}" then "print 'grainforge settle: FAILED, atoms lost'" "quit 1"
@@ -880,7 +880,10 @@ fn primes(n: usize) -> Vec<u64> {
     let mut out = Vec::with_capacity(n);
     let mut k = 100_003u64;
     while out.len() < n {
-        if (2..).take_while(|d| d * d <= k).all(|d| k % d != 0) {
+        if (2..)
+            .take_while(|d| d * d <= k)
+            .all(|d| !k.is_multiple_of(d))
+        {
             out.push(k);
         }
         k += 2;
@@ -1073,7 +1076,7 @@ thermo          {chunk}
 thermo_modify   lost error norm no
 run             0
 variable        phi0 equal {pf:.10}
-variable        phistart equal {phistart}
+variable        phistart equal $(v_phi)
 print           "grainforge settle: bed fraction at the start ${{phistart}} (packed {pf:.6})"
 variable        limit equal {ke:e}
 run             {min}
@@ -1087,11 +1090,11 @@ label           settled
 # computes are current only on output steps: one more step that outputs them all
 thermo_style    custom step atoms v_ke v_phi c_ovl
 run             0
-variable        kefinal equal {kefinal}
-variable        phiend equal {phiend}
-variable        overlap equal {overlap}
+variable        kefinal equal $(v_ke)
+variable        phiend equal $(v_phi)
+variable        overlap equal $(c_ovl)
 write_restart   settled.restart
-print           "grainforge settle: atoms {atoms_now} of {atoms} ({n} bodies), kinetic energy ${{kefinal}} J (limit ${{limit}} J)"
+print           "grainforge settle: atoms $(atoms) of {atoms} ({n} bodies), kinetic energy ${{kefinal}} J (limit ${{limit}} J)"
 print           "grainforge settle: largest overlap ${{overlap}} m (limit {ovm:e} m = {ovl} d50)"
 print           "grainforge settle: bed fraction ${{phistart}} -> ${{phiend}} (packed {pf:.6}, tolerance {ft})"
 variable        nat equal atoms
@@ -1138,14 +1141,9 @@ print           "grainforge settle: OK"
         floor = p.floor,
         chunk = p.chunk,
         pf = p.packed_fraction,
-        phistart = "$(v_phi)",
         ke = p.ke_limit,
         min = p.min_steps,
         chunks = (p.max_steps - p.min_steps).div_ceil(p.chunk).max(1),
-        kefinal = "$(v_ke)",
-        phiend = "$(v_phi)",
-        overlap = "$(c_ovl)",
-        atoms_now = "$(atoms)",
         atoms = p.atoms,
         n = p.n,
         max = p.max_steps,
@@ -1223,11 +1221,9 @@ mod tests {
             .collect()
     }
 
-    fn files(
-        f: fn(&DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u8>)>>,
-        templates: &[Template],
-        container: &Container,
-    ) -> Vec<(String, String)> {
+    type Writer = fn(&DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u8>)>>;
+
+    fn files(f: Writer, templates: &[Template], container: &Container) -> Vec<(String, String)> {
         let b = bodies(templates.len(), 4);
         let material = Material::default();
         let prov = vec!["grainforge test".to_owned()];
@@ -1491,7 +1487,10 @@ mod tests {
         assert_eq!(seeds.len(), 2 + 2 + 4);
         for v in &seeds {
             assert!(
-                *v > 10_000 && (2..).take_while(|d| d * d <= *v).all(|d| v % d != 0),
+                *v > 10_000
+                    && (2..)
+                        .take_while(|d| d * d <= *v)
+                        .all(|d| !v.is_multiple_of(d)),
                 "{v}"
             );
         }
