@@ -67,6 +67,9 @@ enum Command {
     /// and outputs (LS-DEM, LAMMPS/LIGGGHTS/Yade clumps, VTU, DNA and
     /// grading report); only the stages the scene needs run.
     Specimen(specimen::Specimen),
+    /// Check a settled DEM deck of a specimen (lammps/, yade/ or liggghts/): no atom lost,
+    /// overlaps at most 1 % of d50, solid fraction within 0.01 of the packed one.
+    SpecimenCheck(specimen::check::SpecimenCheck),
     /// Write a synthetic labelled CT image of cloned grains (scale tests of
     /// `--parents`).
     SynthScan(synth_scan::SynthScan),
@@ -99,6 +102,7 @@ fn main() -> anyhow::Result<()> {
         Command::Pack(cmd) => cmd.run(&workspace_root()),
         Command::SynthScan(cmd) => cmd.run(&workspace_root()),
         Command::Specimen(cmd) => cmd.run(&workspace_root()),
+        Command::SpecimenCheck(cmd) => cmd.run(&workspace_root()),
     }
 }
 

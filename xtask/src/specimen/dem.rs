@@ -619,6 +619,8 @@ thermo_style    custom step time atoms v_ke v_phi
 thermo          {chunk}
 thermo_modify   lost error norm no
 run             0
+# initial.dump and final.dump (id body x y z radius): for cargo xtask specimen-check
+write_dump      all custom initial.dump id mol x y z radius modify sort id format float %.12g
 variable        phi0 equal {pf:.10}
 variable        phistart equal $(v_phi:%.10f)
 print           "grainforge settle: bed fraction at the start ${{phistart}} (packed {pf:.6})"
@@ -634,7 +636,7 @@ label           settled
 variable        kefinal equal $(v_ke:%.6e)
 variable        phiend equal $(v_phi:%.10f)
 write_restart   settled.restart
-write_dump      all custom final.dump id mol x y z radius modify sort id
+write_dump      all custom final.dump id mol x y z radius modify sort id format float %.12g
 # largest overlap of two spheres of different bodies, by bisection: shrink every radius by s/2
 # (pairs of one body stay excluded) and see whether any pair still touches
 uncompute       ket
@@ -793,6 +795,14 @@ def bed_fraction():
     zbar = sum(O.bodies[i].state.pos[2] for _, i in members) / len(members)
     return {vol:e} / ({area:e} * 2 * (zbar - ({floor:e})))
 
+def dump(name):
+    # id body x y z radius, for cargo xtask specimen-check
+    with open(name, 'w') as f:
+        f.write('# id body x y z radius\n')
+        for b, i in members:
+            p = O.bodies[i].state.pos
+            f.write('%d %d %.12g %.12g %.12g %.12g\n' % (i, b, p[0], p[1], p[2], O.bodies[i].shape.radius))
+
 def largest_overlap():
     worst = 0.0
     for i in O.interactions:
@@ -816,6 +826,7 @@ O.engines = [
 O.dt = {dt:e}
 phi0 = {pf:.10}
 phi_start = bed_fraction()
+dump('initial.dump')
 print('grainforge settle: bed fraction at the start %.6f (packed %.6f)' % (phi_start, phi0))
 limit = {ke:e}
 O.run({min}, True)
@@ -826,6 +837,7 @@ while True:
         break
     O.run({chunk}, True)
 O.save('settled.yade.gz')
+dump('final.dump')
 n = sum(1 for b in bodies if O.bodies[bodies[b]] is not None)
 overlap = largest_overlap()
 phi_end = bed_fraction()

@@ -28,6 +28,7 @@ use packer_quadtree::{Container, Sphere, StarGrain};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
+pub(crate) mod check;
 mod dem;
 mod estimate;
 mod outputs;
@@ -37,7 +38,7 @@ mod scene;
 #[cfg(test)]
 mod tests;
 
-use outputs::{LsdemFrame, PlacedClump, Staging, Surfaces, VtuWriter};
+use outputs::{LsdemFrame, Staging, Surfaces, VtuWriter};
 use scene::{Clones, ContainerSpec, ParentsSpec, Placement, Scene};
 
 /// Cube-map cells per face of the star tables the grain packer packs (and
@@ -539,7 +540,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                         let f = std::fs::File::create(&path)
                             .with_context(|| format!("creating {}", path.display()))?;
                         let mut w = BufWriter::new(f);
-                        levelset::io::write_morph(&mut w, &pm.morph)
+                        levelset::io::write_morph_decimals(&mut w, &pm.morph, MORPH_DECIMALS)
                             .with_context(|| format!("writing {}", path.display()))?;
                         std::io::Write::flush(&mut w)
                             .with_context(|| format!("writing {}", path.display()))?;
@@ -697,7 +698,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     }
     // clumps (shared by the three clump outputs): one clump per distinct shape, trimmed
     // against every copy's neighbours, then the union's mass properties per shape
-    let mut clumps: Vec<PlacedClump> = Vec::new();
+    let mut dem_templates: Vec<dem::Template> = Vec::new();
     match need(out.clumps(), "clump output") {
         Some(r) => st.skip("clumps", &r),
         None => {
@@ -747,23 +748,17 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                     out.clump.spheres_per_clump,
                 )?);
             }
-            clumps = (0..n_grains)
-                .map(|g| {
-                    let tpl = template_of(g);
-                    PlacedClump {
-                        index: g as u64,
-                        template: tpl,
-                        pose: scale_pose(&poses[g], metres),
-                        spheres: template_spheres[tpl]
-                            .iter()
-                            .map(|(c, r)| (c * metres, r * metres))
-                            .collect(),
-                        volume: unions[tpl].volume * metres.powi(3),
-                        centroid: unions[tpl].centroid * metres,
-                        inertia: unions[tpl].inertia * metres.powi(5),
-                    }
+            dem_templates = template_spheres
+                .iter()
+                .zip(&unions)
+                .map(|(s, u)| dem::Template {
+                    spheres: s.iter().map(|(c, r)| (c * metres, r * metres)).collect(),
+                    volume: u.volume * metres.powi(3),
+                    centroid: u.centroid * metres,
+                    inertia: u.inertia * metres.powi(5),
                 })
                 .collect();
+
             st.ran_s(
                 "clumps",
                 cpu(2) + t.elapsed().as_secs_f64(),
@@ -789,54 +784,32 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         }
     }
     let container_m = scale_container(&container, metres);
-    // DEM decks. GLUE (to be replaced by the scene keys): one template per distinct shape as
-    // the clumps stage made it, the scene's density and the default contact constants.
+    let dem_bodies: Vec<dem::Body> = (0..n_grains)
+        .map(|k| dem::Body {
+            id: k as u64,
+            template: template_of(k),
+            pose: scale_pose(&poses[k], metres),
+        })
+        .collect();
+    // GLUE: the scene's density overrides the material's (one key, `outputs.density`)
     let material = dem::Material {
         density: out.density,
-        ..dem::Material::default()
+        ..out.material.clone()
     };
-    let mut dem_templates: Vec<Option<dem::Template>> = vec![None; n_templates];
-    for c in &clumps {
-        dem_templates[c.template].get_or_insert_with(|| dem::Template {
-            spheres: c.spheres.clone(),
-            volume: c.volume,
-            centroid: c.centroid,
-            inertia: c.inertia,
-        });
-    }
-    let dem_templates: Vec<dem::Template> = dem_templates
-        .into_iter()
-        .map(|t| {
-            t.unwrap_or_else(|| dem::Template {
-                spheres: Vec::new(),
-                volume: f64::NAN,
-                centroid: Point3::origin(),
-                inertia: nalgebra::Matrix3::zeros(),
-            })
-        })
-        .collect();
-    let dem_bodies: Vec<dem::Body> = clumps
-        .iter()
-        .map(|c| dem::Body {
-            id: c.index,
-            template: c.template,
-            pose: c.pose,
-        })
-        .collect();
-    let dem_spec = dem::DemSpecimen {
+    let dem_specimen = dem::DemSpecimen {
         templates: &dem_templates,
         bodies: &dem_bodies,
         container: &container_m,
         material: &material,
         provenance: &provenance,
     };
-    // end of GLUE
-    for (name, on, what, write) in [
+    type Writer = fn(&dem::DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u8>)>>;
+    let decks: [(&'static str, bool, &str, Writer); 3] = [
         (
             "lammps",
             out.lammps_clumps,
             "LAMMPS clumps",
-            dem::lammps_files as fn(&dem::DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u8>)>>,
+            dem::lammps_files,
         ),
         (
             "liggghts",
@@ -845,25 +818,31 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             dem::liggghts_files,
         ),
         ("yade", out.yade_clumps, "Yade clumps", dem::yade_files),
-    ] {
+    ];
+    for (name, on, what, write) in decks {
         match need(on, what) {
             Some(r) => st.skip(name, &r),
             None => {
                 let t = Instant::now();
-                let files = write(&dem_spec).with_context(|| format!("{name} deck"))?;
+                let files = write(&dem_specimen).with_context(|| format!("the {name} deck"))?;
                 for (path, bytes) in &files {
                     staging.write(path, bytes)?;
                 }
-                let plan = dem_spec.plan()?;
+                let plan = dem_specimen.plan()?;
+                staging.write(
+                    &format!("{name}/settle.txt"),
+                    check::settle_text(plan.n, plan.atoms, plan.d50, &container_m).as_bytes(),
+                )?;
                 st.ran(
                     name,
                     t,
                     format!(
-                        "{} files: a settle deck with its checks ({} bodies, dt {:.3e} s, at most {} steps; packed bed fraction {:.4})",
-                        files.len(),
-                        plan.n,
+                        "{} files: {name}/ settle deck (Hertz-Mindlin E/{}, union mass and inertia, dt {:.3e} s = Hertz time of the smallest clump / 20, at most {} steps, self-checks: bodies, KE <= {:.3e} J, overlap <= 0.01 d50, bed fraction within 0.01 of {:.4}) + settle.txt",
+                        files.len() + 1,
+                        material.stiffness_scale,
                         plan.dt,
                         plan.max_steps,
+                        plan.ke_limit,
                         plan.packed_fraction
                     ),
                 );
@@ -941,6 +920,11 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     report.files = staging.commit(&out_dir)?;
     Ok(report)
 }
+
+/// Decimals of the level-set values and nodes of the LS-DEM morph files (grid units):
+/// within 5e-10 of the exact values, and the products of inertia of the file's own level
+/// set stay below 1e-11 of its moments (`specimen/lsdem-files` parses the files).
+const MORPH_DECIMALS: u32 = 9;
 
 /// Lattice cells per equivalent diameter of the union integration of a clump
 /// (`levelset::union_mass_properties`; validated by `specimen/clump-mass` at the same

@@ -237,23 +237,6 @@ pub(crate) fn lsdem_files(
     })
 }
 
-/// The clump of one placed grain, in metres: its spheres in the clone frame, the union's
-/// volume, centroid and inertia (per unit density, clone frame) of its shape.
-pub(crate) struct PlacedClump {
-    pub(crate) index: u64,
-    /// The distinct shape it copies.
-    #[allow(dead_code)]
-    pub(crate) template: usize,
-    pub(crate) pose: Isometry3<f64>,
-    pub(crate) spheres: Vec<(Point3<f64>, f64)>,
-    #[allow(dead_code)]
-    pub(crate) volume: f64,
-    #[allow(dead_code)]
-    pub(crate) centroid: Point3<f64>,
-    #[allow(dead_code)]
-    pub(crate) inertia: nalgebra::Matrix3<f64>,
-}
-
 /// A streaming VTU (UnstructuredGrid, VTK XML with inline binary data) of
 /// grain surfaces: one `<Piece>` per call of [`VtuWriter::piece`],
 /// triangles with a `grain_id` cell field.

@@ -264,6 +264,8 @@ pub(crate) struct Outputs {
     pub(crate) density: f64,
     /// LS-DEM test name: `InitState/positions_<NAME>.dat`, `rotations_<NAME>.dat`.
     pub(crate) lsdem_name: String,
+    /// Contact constants of the DEM decks (Hertz–Mindlin, quartz; `dem.rs`).
+    pub(crate) material: super::dem::Material,
     /// VTU of the marching-cubes surfaces of every placed grain.
     pub(crate) vtu: bool,
     /// Cells across the widest side of each grain's level-set box for its
@@ -288,6 +290,7 @@ impl Default for Outputs {
             clump: ClumpSpec::default(),
             density: QUARTZ_DENSITY,
             lsdem_name: "specimen".into(),
+            material: super::dem::Material::default(),
             vtu: false,
             vtu_resolution: 16,
             report: false,
@@ -428,6 +431,10 @@ impl Scene {
                 self.clones.count()
             );
         }
+        self.outputs
+            .material
+            .validate()
+            .with_context(|| format!("{at}: `outputs.material`"))?;
         let name = &self.outputs.lsdem_name;
         if name.is_empty()
             || !name

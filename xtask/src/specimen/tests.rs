@@ -154,27 +154,34 @@ fn each_output_flag_changes_only_its_own_files() {
         .filter_map(|l| l.split_whitespace().last().map(String::from))
         .collect();
     assert_eq!(spacings.len(), 1, "{spacings:?}");
-    // the LAMMPS deck: one rigid-body line per grain, every clump sphere in the data file
+    // LAMMPS: one rigid-body line per grain (the union's mass > 0), a Molecules section
+    // naming a body for every atom, and the deck
     let rigid = std::fs::read_to_string(dir.join("flag-1/lammps/bodies.rigid")).expect("rigid");
-    let n_body: usize = rigid
-        .lines()
-        .find(|l| !l.starts_with('#'))
-        .and_then(|l| l.trim().parse().ok())
-        .expect("count line");
-    assert_eq!(n_body, 20);
+    let lines: Vec<&str> = rigid.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(lines[0].trim(), "20");
+    assert_eq!(lines.len(), 21);
+    for l in &lines[1..] {
+        let v: Vec<f64> = l
+            .split_whitespace()
+            .map(|x| x.parse().expect("number"))
+            .collect();
+        assert_eq!(v.len(), 20);
+        assert!(v[1] > 0.0 && v[5] > 0.0 && v[6] > 0.0 && v[7] > 0.0, "{l}");
+    }
     let data = std::fs::read_to_string(dir.join("flag-1/lammps/clumps.data")).expect("data");
     let atoms: usize = data
         .lines()
-        .find_map(|l| l.strip_suffix(" atoms"))
-        .and_then(|n| n.trim().parse().ok())
-        .expect("atoms line");
-    let molecules = data.split("Molecules\n\n").nth(1).expect("Molecules");
-    assert_eq!(molecules.lines().count(), atoms);
-    assert!(
-        std::fs::read_to_string(dir.join("flag-1/lammps/in.settle"))
-            .expect("deck")
-            .contains("rigid/small molecule infile bodies.rigid")
-    );
+        .find(|l| l.ends_with(" atoms"))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .expect("atom count");
+    let mols = data
+        .split("\nMolecules\n")
+        .nth(1)
+        .expect("a Molecules section");
+    assert_eq!(mols.lines().filter(|l| !l.trim().is_empty()).count(), atoms);
+    let deck = std::fs::read_to_string(dir.join("flag-1/lammps/in.settle")).expect("deck");
+    assert!(deck.contains("read_data       clumps.data fix mol NULL Molecules"));
     let vtu = std::fs::read_to_string(dir.join("flag-4/specimen.vtu")).expect("vtu");
     assert!(vtu.contains("grain_id") && vtu.trim_end().ends_with("</VTKFile>"));
     assert!(vtu.contains(r#"header_type="UInt64""#) && !vtu.contains(r#"format="ascii""#));

@@ -32,7 +32,7 @@ mod vtk;
 
 pub use lammps::{read_lammps, write_lammps};
 pub use lsdem::{PrincipalMorph, principal_morph};
-pub use morph::{MorphFile, read_morph, write_morph};
+pub use morph::{MorphFile, read_morph, write_morph, write_morph_decimals};
 pub use npy::{read_npy, write_npy};
 pub use obj::{read_obj, write_obj};
 pub use raw::{Dtype, RawLayout, read_raw, write_raw};

@@ -77,6 +77,41 @@ fn morph_round_trip_is_exact_and_from_grid_is_consistent() {
     assert_eq!(text.lines().count(), 8, "one field per line");
 }
 
+/// Fixed-decimal morph files: every value within half a unit of the last decimal, the
+/// mass and moments exact, smaller than the round-trip file; bad decimals and huge values
+/// are errors.
+#[test]
+fn morph_fixed_decimals_round_trip_within_half_an_ulp_of_the_last_digit() {
+    let spec = GridSpec::cube(25, -1.2, 1.2).expect("spec");
+    let g =
+        Grid::from_shape(spec, &Sphere::new(1.0).expect("s"), &Isometry3::identity()).expect("g");
+    let m = MorphFile::from_grid(&g, 2.0, 50).expect("morph");
+    let mut exact = Vec::new();
+    write_morph(&mut exact, &m).expect("write");
+    for decimals in [0u32, 3, 9] {
+        let mut buf = Vec::new();
+        write_morph_decimals(&mut buf, &m, decimals).expect("write");
+        let back = read_morph(buf.as_slice()).expect("read");
+        let tol = 0.5 * 10f64.powi(-(decimals as i32)) * (1.0 + 1e-9);
+        assert_abs_diff_eq!(back.mass, m.mass, epsilon = 0.0);
+        for (a, b) in back.grid.values().iter().zip(m.grid.values()) {
+            assert!((a - b).abs() <= tol, "{a} {b} at {decimals}");
+        }
+        for (p, q) in back.points.iter().zip(&m.points) {
+            assert!((p - q).amax() <= tol);
+        }
+        assert!(buf.len() < exact.len());
+    }
+    // negative values keep their sign below one unit
+    let mut buf = Vec::new();
+    write_morph_decimals(&mut buf, &m, 9).expect("write");
+    assert!(String::from_utf8(buf).expect("utf8").contains(" -0."));
+    assert!(write_morph_decimals(Vec::new(), &m, 13).is_err());
+    let mut huge = m.clone();
+    huge.points[0].x = 1e30;
+    assert!(write_morph_decimals(Vec::new(), &huge, 9).is_err());
+}
+
 #[test]
 fn stl_round_trips() {
     let spec = GridSpec::cube(15, -1.2, 1.2).expect("spec");

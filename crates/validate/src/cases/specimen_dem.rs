@@ -202,7 +202,8 @@ fn lsdem_files() -> Result<Vec<Check>, Error> {
     let mut folder: BTreeMap<String, Entry> = BTreeMap::new();
     for (k, m) in morphs.iter().enumerate() {
         let mut bytes = Vec::new();
-        levelset::io::write_morph(&mut bytes, &m.morph).map_err(err)?;
+        // as `cargo xtask specimen` writes them: 9 decimals
+        levelset::io::write_morph_decimals(&mut bytes, &m.morph, 9).map_err(err)?;
         folder.insert(lsdem::morph_path(k + 1), Entry::File(bytes));
     }
     let grains: Vec<(usize, Isometry3<f64>)> = morphs
