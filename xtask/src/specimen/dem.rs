@@ -6,6 +6,8 @@
 //! `ERROR`, Yade `SystemExit(1)`), so that a CI step catches it.
 //!
 //! Pure functions: they return `(path relative to out_dir, bytes)`; `mod.rs` stages them.
+//! LAMMPS and Yade also write `initial.dump` and `final.dump` (`id body x y z radius`) that
+//! `cargo xtask specimen-check` measures again (`check.rs`; `mod.rs` adds `settle.txt`).
 //!
 //! # Contact model (the same in the three codes)
 //! Hertz–Mindlin, quartz by default: E = 70 GPa, ν = 0.2, E divided by
