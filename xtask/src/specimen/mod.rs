@@ -786,67 +786,67 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     let container_m = scale_container(&container, metres);
     let dem_bodies: Vec<dem::Body> = (0..n_grains)
         .map(|k| dem::Body {
+            id: k as u64,
             template: template_of(k),
             pose: scale_pose(&poses[k], metres),
         })
         .collect();
+    // GLUE: the scene's density overrides the material's (one key, `outputs.density`)
+    let material = dem::Material {
+        density: out.density,
+        ..out.material.clone()
+    };
     let dem_specimen = dem::DemSpecimen {
         templates: &dem_templates,
         bodies: &dem_bodies,
         container: &container_m,
-        material: &out.material,
-        density: out.density,
+        material: &material,
         provenance: &provenance,
     };
-    match need(out.lammps_clumps, "LAMMPS clumps") {
-        Some(r) => st.skip("lammps", &r),
-        None => {
-            let t = Instant::now();
-            let files = dem::lammps_files(&dem_specimen)?;
-            for (name, bytes) in &files {
-                staging.write(name, bytes)?;
+    type Writer = fn(&dem::DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u8>)>>;
+    let decks: [(&'static str, bool, &str, Writer); 3] = [
+        (
+            "lammps",
+            out.lammps_clumps,
+            "LAMMPS clumps",
+            dem::lammps_files,
+        ),
+        (
+            "liggghts",
+            out.liggghts_templates,
+            "LIGGGHTS templates",
+            dem::liggghts_files,
+        ),
+        ("yade", out.yade_clumps, "Yade clumps", dem::yade_files),
+    ];
+    for (name, on, what, write) in decks {
+        match need(on, what) {
+            Some(r) => st.skip(name, &r),
+            None => {
+                let t = Instant::now();
+                let files = write(&dem_specimen).with_context(|| format!("the {name} deck"))?;
+                for (path, bytes) in &files {
+                    staging.write(path, bytes)?;
+                }
+                let plan = dem_specimen.plan()?;
+                staging.write(
+                    &format!("{name}/settle.txt"),
+                    check::settle_text(plan.n, plan.atoms, plan.d50, &container_m).as_bytes(),
+                )?;
+                st.ran(
+                    name,
+                    t,
+                    format!(
+                        "{} files: {name}/ settle deck (Hertz-Mindlin E/{}, union mass and inertia, dt {:.3e} s = Hertz time of the smallest clump / 20, at most {} steps, self-checks: bodies, KE <= {:.3e} J, overlap <= 0.01 d50, bed fraction within 0.01 of {:.4}) + settle.txt",
+                        files.len() + 1,
+                        material.stiffness_scale,
+                        plan.dt,
+                        plan.max_steps,
+                        plan.ke_limit,
+                        plan.packed_fraction
+                    ),
+                );
             }
-            let sp = dem_specimen.settle()?;
-            st.ran(
-                "lammps",
-                t,
-                format!(
-                    "lammps/clumps.data + bodies.rigid (union mass, centre, inertia per body) + in.settle (Hertz-Mindlin, E/{}, dt {:.3e} s = 0.2 Rayleigh of the smallest clump, settle to KE <= {:.3e} J)",
-                    out.material.stiffness_scale, sp.dt, sp.ke_limit
-                ),
-            );
-        }
-    }
-    match need(out.liggghts_templates, "LIGGGHTS templates") {
-        Some(r) => st.skip("liggghts", &r),
-        None => {
-            let t = Instant::now();
-            let files = dem::liggghts_files(&dem_specimen)?;
-            for (name, bytes) in &files {
-                staging.write(name, bytes)?;
-            }
-            st.ran(
-                "liggghts",
-                t,
-                format!(
-                    "{} multisphere templates (union mass and inertia) + liggghts/templates.in (numberbased weights)",
-                    files.len() - 1
-                ),
-            );
-        }
-    }
-    match need(out.yade_clumps, "Yade clumps") {
-        Some(r) => st.skip("yade", &r),
-        None => {
-            let t = Instant::now();
-            for (name, bytes) in &dem::yade_files(&dem_specimen)? {
-                staging.write(name, bytes)?;
-            }
-            st.ran(
-                "yade",
-                t,
-                "yade/clumps.txt + settle.py (Hertz-Mindlin, appendClumped with discretization, settle) + settle.txt".into(),
-            );
         }
     }
     match need(out.vtu, "VTU") {
