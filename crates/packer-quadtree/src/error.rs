@@ -209,6 +209,17 @@ pub enum Error {
         /// Grain scale reached by the growth (1 = full size).
         scale: f64,
     },
+    /// A requested solid fraction lies beyond what the densification can
+    /// free of overlaps (beyond jamming).
+    #[error(
+        "solid fraction {requested} cannot be reached: the packing jams at {reached:.4} (the densest overlap-free state found)"
+    )]
+    FractionNotReached {
+        /// The requested fraction.
+        requested: f64,
+        /// The highest overlap-free fraction reached.
+        reached: f64,
+    },
     /// An I/O error from a reader or a writer.
     #[error("reading or writing failed: {0}")]
     Io(#[from] std::io::Error),

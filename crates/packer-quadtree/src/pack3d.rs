@@ -90,11 +90,13 @@
 //! thread count.
 
 mod container;
+mod densify;
 mod io;
 mod metrics;
 mod slabs;
 
 pub use container::{Container, MeshContainer};
+pub use densify::{Boundary, Densified, DensifyParams, DensifyStats, Target, densify, max_overlap};
 pub use io::{
     LammpsData3, read_csv3, read_lammps_data3, read_vtu3, read_yade3, write_csv3,
     write_lammps_data3, write_vtu3, write_yade3,
