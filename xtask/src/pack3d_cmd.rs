@@ -16,7 +16,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use levelset::Orientation;
 use nalgebra::Point3;
-use packer_quadtree::{Container, Grading, Pack3Params, Packing3};
+use packer_quadtree::{Boundary, Container, DensifyParams, Grading, Pack3Params, Sphere, Target};
 
 use crate::pack_cmd::{Output, Preset};
 use crate::progress::write_atomic;
@@ -30,6 +30,10 @@ pub(crate) fn parse_container(s: &str, root: &Path) -> anyhow::Result<Container>
         "box" => {
             let mut parts: Vec<&str> = rest.split(',').collect();
             let periodic = match parts.last().copied() {
+                Some("periodic-xyz") => bail!(
+                    "box:…,periodic-xyz (fully periodic) needs --target-fraction: the front packs \
+                     with walls in z, the densification closes them"
+                ),
                 Some("periodic") => {
                     parts.pop();
                     [true, true]
@@ -100,6 +104,38 @@ pub(crate) fn parse_container(s: &str, root: &Path) -> anyhow::Result<Container>
     })
 }
 
+/// Parses `--container` into a densification domain: as [`parse_container`],
+/// plus `box:LX,LY,LZ,periodic-xyz` (periodic in x, y and z); meshes are refused.
+pub(crate) fn parse_boundary(s: &str, root: &Path) -> anyhow::Result<Boundary> {
+    if let Some(rest) = s.strip_prefix("box:")
+        && let Some(dims) = rest.strip_suffix(",periodic-xyz")
+    {
+        let c = parse_container(&format!("box:{dims}"), root)?;
+        let (min, max) = c.bbox();
+        return Ok(Boundary::Periodic { min, max });
+    }
+    let c = parse_container(s, root)?;
+    if matches!(c, Container::Mesh(_)) {
+        bail!("--target-fraction needs a box or cylinder container, not a mesh");
+    }
+    Ok(Boundary::Walls(c))
+}
+
+/// Parses `--target-fraction`: a solid fraction in (0, 0.74] or `jammed`.
+pub(crate) fn parse_target(s: &str) -> anyhow::Result<Target> {
+    if s.trim() == "jammed" {
+        return Ok(Target::Jammed);
+    }
+    let f: f64 = s
+        .trim()
+        .parse()
+        .with_context(|| format!("--target-fraction: `{s}` is neither a number nor `jammed`"))?;
+    if !(f.is_finite() && f > 0.0 && f <= 0.74) {
+        bail!("--target-fraction must be in (0, 0.74] or `jammed`, got {s}");
+    }
+    Ok(Target::Fraction(f))
+}
+
 /// A 3D packing run of `cargo xtask pack`.
 pub(crate) struct Run3<'a> {
     pub(crate) container: &'a str,
@@ -109,21 +145,18 @@ pub(crate) struct Run3<'a> {
     pub(crate) formats: &'a [Output],
     pub(crate) density: f64,
     pub(crate) out: PathBuf,
+    /// Densify to this target after the front.
+    pub(crate) target: Option<&'a str>,
 }
 
 impl Run3<'_> {
     pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
         let t0 = Instant::now();
+        if let Some(t) = self.target {
+            return self.run_dense(root, parse_target(t)?, t0);
+        }
         let container = parse_container(self.container, root)?;
-        let params = match self.preset {
-            Preset::Default => Pack3Params::default(),
-            Preset::Dense => Pack3Params::dense(),
-            Preset::Seed => Pack3Params {
-                lookahead: 1,
-                slabs: 0,
-                ..Pack3Params::default()
-            },
-        };
+        let params = self.params();
         if !(self.density.is_finite() && self.density > 0.0) {
             bail!(
                 "--density must be positive and finite, got {}",
@@ -135,41 +168,10 @@ impl Run3<'_> {
         let p = packer_quadtree::pack3d_seeded(&container, &self.grading, &params, self.seed)?;
         let t_pack = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
-        let report = metrics_report(&container, &self.grading, &p)?;
+        let report = metrics_report(&container, &self.grading, &p.spheres)?;
         let t_check = t2.elapsed().as_secs_f64();
         let t3 = Instant::now();
-        let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-        for f in self.formats {
-            let (name, bytes) = match f {
-                Output::Csv => {
-                    let mut b = Vec::new();
-                    packer_quadtree::write_csv3(&p.spheres, &mut b)?;
-                    ("packing.csv", b)
-                }
-                Output::Vtu => {
-                    let mut b = Vec::new();
-                    packer_quadtree::write_vtu3(&p.spheres, &mut b)?;
-                    ("packing.vtu", b)
-                }
-                Output::Lammps => {
-                    let mut b = Vec::new();
-                    packer_quadtree::write_lammps_data3(
-                        &p.spheres,
-                        &container,
-                        self.density,
-                        &mut b,
-                    )?;
-                    ("packing.data", b)
-                }
-                Output::Yade => {
-                    let mut b = Vec::new();
-                    packer_quadtree::write_yade3(&p.spheres, &mut b)?;
-                    ("packing.txt", b)
-                }
-                Output::Svg => continue,
-            };
-            files.push((self.out.join(name), bytes));
-        }
+        let files = self.files(&p.spheres, &container, false)?;
         let dir = root.join(&self.out);
         for (path, bytes) in &files {
             write_atomic(&root.join(path), bytes)?;
@@ -202,6 +204,170 @@ impl Run3<'_> {
         println!("written to {}", dir.display());
         Ok(())
     }
+
+    fn params(&self) -> Pack3Params {
+        match self.preset {
+            Preset::Default => Pack3Params::default(),
+            Preset::Dense => Pack3Params::dense(),
+            Preset::Seed => Pack3Params {
+                lookahead: 1,
+                slabs: 0,
+                ..Pack3Params::default()
+            },
+        }
+    }
+
+    /// The front, then the densification to `target` (`--target-fraction`).
+    fn run_dense(&self, root: &Path, target: Target, t0: Instant) -> anyhow::Result<()> {
+        let boundary = parse_boundary(self.container, root)?;
+        if !(self.density.is_finite() && self.density > 0.0) {
+            bail!(
+                "--density must be positive and finite, got {}",
+                self.density
+            );
+        }
+        let t_setup = t0.elapsed().as_secs_f64();
+        let t1 = Instant::now();
+        let dense = DensifyParams {
+            target,
+            ..DensifyParams::default()
+        };
+        let p = packer_quadtree::pack3d_dense(
+            &boundary,
+            &self.grading,
+            &self.params(),
+            &dense,
+            self.seed,
+        )?;
+        let t_pack = t1.elapsed().as_secs_f64();
+        let t2 = Instant::now();
+        let (report, container, fully) = match &p.boundary {
+            Boundary::Walls(c) => (
+                metrics_report(c, &self.grading, &p.spheres)?,
+                c.clone(),
+                false,
+            ),
+            Boundary::Periodic { min, max } => {
+                let worst = packer_quadtree::max_overlap(&p.spheres, &p.boundary)?;
+                if worst > 1e-9 {
+                    bail!(
+                        "the independent check rejects this packing (worst overlap / d {worst:.2e}): \
+                         nothing written; please report it with the command line"
+                    );
+                }
+                let g = packer_quadtree::grading_report(&self.grading, &p.spheres)?;
+                let mut t = String::new();
+                let _ = writeln!(
+                    t,
+                    "{} spheres, solid fraction {:.4} (periodic in x, y and z; box {:.4} × {:.4} × \
+                     {:.4}); worst overlap / d {worst:.2e}",
+                    p.spheres.len(),
+                    p.fraction,
+                    max.x - min.x,
+                    max.y - min.y,
+                    max.z - min.z
+                );
+                let _ = writeln!(
+                    t,
+                    "grading by mass: Cu {:.3} (requested {:.3}), Cc {:.3} (requested {:.3}), max \
+                     deviation of the passing curve {:.4}",
+                    g.packed.cu, g.requested.cu, g.packed.cc, g.requested.cc, g.max_deviation
+                );
+                let c = Container::Box {
+                    min: *min,
+                    max: *max,
+                    periodic: [true, true],
+                };
+                (t, c, true)
+            }
+            other => bail!("unsupported densification domain {other:?}"),
+        };
+        let t_check = t2.elapsed().as_secs_f64();
+        let t3 = Instant::now();
+        let files = self.files(&p.spheres, &container, fully)?;
+        let dir = root.join(&self.out);
+        for (path, bytes) in &files {
+            write_atomic(&root.join(path), bytes)?;
+        }
+        let t_write = t3.elapsed().as_secs_f64();
+        let mut text = report;
+        let n = p.spheres.len() as f64;
+        let _ = writeln!(
+            text,
+            "densified to {} (target {}): front placed {} spheres, {} removed at random for the \
+             target, then {} compression steps ({} undone), {} FIRE iterations, {} neighbour \
+             builds, largest overlap before the final expansion ≤ {:.0e} d_min",
+            format_args!("{:.4}", p.fraction),
+            match target {
+                Target::Fraction(f) => format!("{f}"),
+                _ => "jammed".into(),
+            },
+            p.placed,
+            p.removed,
+            p.densify.steps_accepted,
+            p.densify.steps_rejected,
+            p.densify.iterations,
+            p.densify.neighbour_builds,
+            dense.tolerance
+        );
+        let _ = writeln!(
+            text,
+            "stage times: setup {t_setup:.3} s, front + densify {t_pack:.3} s ({:.0} spheres/s), \
+             check and metrics {t_check:.3} s, write {t_write:.3} s",
+            n / t_pack.max(1e-9)
+        );
+        write_atomic(&dir.join("report.txt"), text.as_bytes())?;
+        print!("{text}");
+        println!("written to {}", dir.display());
+        Ok(())
+    }
+
+    /// The output files of `spheres` (`fully`: periodic in z too, named on the LAMMPS title).
+    fn files(
+        &self,
+        spheres: &[Sphere],
+        container: &Container,
+        fully: bool,
+    ) -> anyhow::Result<Vec<(PathBuf, Vec<u8>)>> {
+        let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+        for f in self.formats {
+            let (name, bytes) = match f {
+                Output::Csv => {
+                    let mut b = Vec::new();
+                    packer_quadtree::write_csv3(spheres, &mut b)?;
+                    ("packing.csv", b)
+                }
+                Output::Vtu => {
+                    let mut b = Vec::new();
+                    packer_quadtree::write_vtu3(spheres, &mut b)?;
+                    ("packing.vtu", b)
+                }
+                Output::Lammps => {
+                    let mut b = Vec::new();
+                    packer_quadtree::write_lammps_data3(spheres, container, self.density, &mut b)?;
+                    if fully {
+                        // the box is periodic in z too: the title line names the boundary
+                        let text = String::from_utf8(b)?;
+                        let (title, rest) = text.split_once('\n').unwrap_or((&text, ""));
+                        b = format!(
+                            "{}\n{rest}",
+                            title.replace("boundary p p f", "boundary p p p")
+                        )
+                        .into_bytes();
+                    }
+                    ("packing.data", b)
+                }
+                Output::Yade => {
+                    let mut b = Vec::new();
+                    packer_quadtree::write_yade3(spheres, &mut b)?;
+                    ("packing.txt", b)
+                }
+                Output::Svg => continue,
+            };
+            files.push((self.out.join(name), bytes));
+        }
+        Ok(files)
+    }
 }
 
 /// The checked metrics of a packing, as report text; an error when the
@@ -209,11 +375,11 @@ impl Run3<'_> {
 fn metrics_report(
     container: &Container,
     grading: &Grading,
-    p: &Packing3,
+    spheres: &[Sphere],
 ) -> anyhow::Result<String> {
     let mut text = String::new();
     let d_max = grading.d_max();
-    let check = packer_quadtree::check_spheres(container, &p.spheres, 1e-9)?;
+    let check = packer_quadtree::check_spheres(container, spheres, 1e-9)?;
     if !check.is_clean(1e-9) {
         bail!(
             "the independent checker rejects this packing (worst pair gap / d {:.2e}, worst wall \
@@ -222,17 +388,17 @@ fn metrics_report(
             check.worst_normalised_wall_gap
         );
     }
-    let overall = packer_quadtree::solid_fraction(container, &p.spheres)?;
+    let overall = packer_quadtree::solid_fraction(container, spheres)?;
     let _ = writeln!(
         text,
         "{} spheres, solid fraction {overall:.4} overall; mean coordination number {:.2}; worst \
          gap / d {:.2e} (pairs), {:.2e} (walls)",
-        p.spheres.len(),
+        spheres.len(),
         check.coordination_number,
         check.worst_normalised_gap,
         check.worst_normalised_wall_gap
     );
-    match packer_quadtree::core_solid_fraction(container, &p.spheres, 2.0 * d_max) {
+    match packer_quadtree::core_solid_fraction(container, spheres, 2.0 * d_max) {
         Ok(core) => {
             let _ = writeln!(
                 text,
@@ -247,7 +413,7 @@ fn metrics_report(
     }
     if let Container::Cylinder { radius, .. } = container {
         let bins = ((radius / (0.5 * d_max)).round() as usize).clamp(4, 200);
-        let prof = packer_quadtree::radial_profile(container, &p.spheres, bins)?;
+        let prof = packer_quadtree::radial_profile(container, spheres, bins)?;
         let _ = writeln!(text, "radial solid fraction profile (annulus: fraction):");
         for b in prof {
             let _ = writeln!(
@@ -257,7 +423,7 @@ fn metrics_report(
             );
         }
     }
-    let g = packer_quadtree::grading_report(grading, &p.spheres)?;
+    let g = packer_quadtree::grading_report(grading, spheres)?;
     let _ = writeln!(
         text,
         "grading by mass: Cu {:.3} (requested {:.3}), Cc {:.3} (requested {:.3}), max deviation of \
@@ -269,9 +435,31 @@ fn metrics_report(
 
 #[cfg(test)]
 mod tests {
-    use super::parse_container;
-    use packer_quadtree::Container;
+    use super::{parse_boundary, parse_container, parse_target};
+    use packer_quadtree::{Boundary, Container, Target};
     use std::path::Path;
+
+    #[test]
+    fn targets_and_periodic_boxes_parse() {
+        assert_eq!(parse_target("0.64").expect("0.64"), Target::Fraction(0.64));
+        assert_eq!(parse_target(" jammed").expect("jammed"), Target::Jammed);
+        for bad in ["0.75", "0", "-0.2", "NaN", "inf", "dense", ""] {
+            let e = parse_target(bad).expect_err(bad).to_string();
+            assert!(e.contains("--target-fraction"), "{bad}: {e}");
+        }
+        let root = Path::new(".");
+        assert!(matches!(
+            parse_boundary("box:30,30,30,periodic-xyz", root),
+            Ok(Boundary::Periodic { .. })
+        ));
+        assert!(matches!(
+            parse_boundary("cylinder:20", root),
+            Ok(Boundary::Walls(Container::Cylinder { .. }))
+        ));
+        // fully periodic needs the densification
+        let e = parse_container("box:30,30,30,periodic-xyz", root).expect_err("front only");
+        assert!(e.to_string().contains("--target-fraction"), "{e}");
+    }
 
     #[test]
     fn containers_parse() {

@@ -101,6 +101,12 @@ pub(crate) struct Pack {
     /// `--dim 3`; default with `--dim 3`: `box:80,80,80`.
     #[arg(long)]
     container: Option<String>,
+    /// 3D only: after the front, densify (affine compression with FIRE
+    /// overlap relaxation, `packer-quadtree::densify`) to this solid fraction
+    /// of the container, in (0, 0.74], or to `jammed` (the container shrinks
+    /// to the jamming point). Also allows `box:LX,LY,LZ,periodic-xyz`.
+    #[arg(long)]
+    target_fraction: Option<String>,
     /// Side of the square/cube of the particle-in-contact packer.
     #[arg(long, default_value_t = 20.0)]
     side: f64,
@@ -334,8 +340,12 @@ impl Pack {
                 formats: &self.formats,
                 density: self.density,
                 out: self.out.clone(),
+                target: self.target_fraction.as_deref(),
             }
             .run(root);
+        }
+        if self.target_fraction.is_some() {
+            bail!("--target-fraction applies to --dim 3 sphere packings only");
         }
         if self.shape != "disk" {
             let (dim, params) = parse_shape(

@@ -113,11 +113,12 @@ pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
 };
 pub use pack3d::{
-    Boundary, Container, CoreFraction, Densified, DensifyParams, DensifyStats, GradingReport,
-    GradingStats, LammpsData3, MeshContainer, Pack3Params, Pack3Stats, Packing3, RadialBin, Sphere,
-    SphereReport, Target, check_spheres, core_solid_fraction, densify, grading_report, max_overlap,
-    pack3d, pack3d_seeded, pack3d_sizes, radial_profile, read_csv3, read_lammps_data3, read_vtu3,
-    read_yade3, solid_fraction, write_csv3, write_lammps_data3, write_vtu3, write_yade3,
+    Boundary, Container, CoreFraction, DensePacking3, Densified, DensifyParams, DensifyStats,
+    GradingReport, GradingStats, LammpsData3, MeshContainer, Pack3Params, Pack3Stats, Packing3,
+    RadialBin, Sphere, SphereReport, Target, check_spheres, core_solid_fraction, densify,
+    grading_report, max_overlap, pack3d, pack3d_dense, pack3d_seeded, pack3d_sizes, radial_profile,
+    read_csv3, read_lammps_data3, read_vtu3, read_yade3, solid_fraction, write_csv3,
+    write_lammps_data3, write_vtu3, write_yade3,
 };
 pub use packer::{
     BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,

@@ -96,7 +96,10 @@ mod metrics;
 mod slabs;
 
 pub use container::{Container, MeshContainer};
-pub use densify::{Boundary, Densified, DensifyParams, DensifyStats, Target, densify, max_overlap};
+pub use densify::{
+    Boundary, DensePacking3, Densified, DensifyParams, DensifyStats, Target, densify, max_overlap,
+    pack3d_dense,
+};
 pub use io::{
     LammpsData3, read_csv3, read_lammps_data3, read_vtu3, read_yade3, write_csv3,
     write_lammps_data3, write_vtu3, write_yade3,

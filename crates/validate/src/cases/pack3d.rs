@@ -12,9 +12,10 @@
 
 use levelset::nalgebra::{Point3, Vector3};
 use packer_quadtree::{
-    Container, Grading, Pack3Params, Packing3, Sphere, check_spheres, core_solid_fraction,
-    grading_report, pack3d_seeded, radial_profile, read_csv3, read_lammps_data3, read_vtu3,
-    read_yade3, solid_fraction, write_csv3, write_lammps_data3, write_vtu3, write_yade3,
+    Boundary, Container, DensePacking3, DensifyParams, Grading, Pack3Params, Packing3, Sphere,
+    Target, check_spheres, core_solid_fraction, grading_report, max_overlap, pack3d_dense,
+    pack3d_seeded, radial_profile, read_csv3, read_lammps_data3, read_vtu3, read_yade3,
+    solid_fraction, write_csv3, write_lammps_data3, write_vtu3, write_yade3,
 };
 
 use crate::{Case, Check, Error, ExpectedFailure, Tolerance};
@@ -58,12 +59,106 @@ pub(crate) fn cases() -> Vec<Case> {
             run: meshes,
         },
         Case {
+            name: "pack3d/jammed-periodic",
+            description: "≈ 10,000 spheres d ~ U[1,2] in a fully periodic cube, front then densify (affine compression + FIRE): solid fraction ≥ 0.640, zero overlaps through every face, grading kept",
+            fast: false,
+            run: jammed_periodic,
+        },
+        Case {
+            name: "pack3d/jammed-walled",
+            description: "front then densify in a walled box (24 d_max) and a triaxial cylinder (D = 12 d_max): core solid fraction ≥ 0.635, zero overlaps",
+            fast: false,
+            run: jammed_walled,
+        },
+        Case {
             name: "pack3d/exports-roundtrip",
             description: "LAMMPS/LIGGGHTS data, Yade text, CSV and VTU of a packing read back bit for bit",
             fast: true,
             run: exports,
         },
     ]
+}
+
+/// Side of the periodic cube holding 10,000 spheres of U[1, 2] (mean volume π/6 · 3.75) at 0.64.
+fn periodic_side(n: f64, phi: f64) -> f64 {
+    (n * std::f64::consts::PI / 6.0 * 3.75 / phi).cbrt()
+}
+
+fn dense(boundary: &Boundary, target: f64) -> Result<DensePacking3, Error> {
+    let p = DensifyParams {
+        target: Target::Fraction(target),
+        ..DensifyParams::default()
+    };
+    pack3d_dense(boundary, &uniform(), &Pack3Params::default(), &p, 1).map_err(Error::computation)
+}
+
+fn jammed_periodic() -> Result<Vec<Check>, Error> {
+    let l = periodic_side(10_000.0, 0.64);
+    let b = Boundary::Periodic {
+        min: Point3::origin(),
+        max: Point3::new(l, l, l),
+    };
+    let p = dense(&b, 0.64)?;
+    let worst = max_overlap(&p.spheres, &p.boundary).map_err(Error::computation)?;
+    let gr = grading_report(&uniform(), &p.spheres).map_err(Error::computation)?;
+    Ok(vec![
+        Check::new(
+            "solid fraction (periodic)",
+            0.640,
+            p.fraction,
+            Tolerance::AtLeast(0.0),
+        ),
+        Check::new(
+            "spheres (about 10,000)",
+            10_000.0,
+            p.spheres.len() as f64,
+            Tolerance::Relative(0.02),
+        ),
+        Check::new(
+            "worst overlap / d (minimum image)",
+            0.0,
+            worst,
+            Tolerance::AtMost(1e-9),
+        ),
+        Check::new(
+            "Cu by mass (packed vs requested)",
+            gr.requested.cu,
+            gr.packed.cu,
+            Tolerance::Relative(0.01),
+        ),
+    ])
+}
+
+fn jammed_walled() -> Result<Vec<Check>, Error> {
+    let mut out = Vec::new();
+    for (name, c, target) in [
+        (
+            "box",
+            Container::walled_box(Vector3::new(48.0, 48.0, 48.0)),
+            0.625,
+        ),
+        ("cylinder", Container::triaxial(24.0), 0.615),
+    ] {
+        let p = dense(&Boundary::Walls(c), target)?;
+        let Boundary::Walls(c) = &p.boundary else {
+            return Err(Error::computation("the densified domain is not walled"));
+        };
+        let mut checks = vec![
+            Check::new(
+                "overall solid fraction (target)",
+                target,
+                p.fraction,
+                Tolerance::AtLeast(0.0),
+            ),
+            core_check(c, &p.spheres, 2.0, 0.635)?,
+        ];
+        checks.extend(overlap_checks(c, &p.spheres)?);
+        for mut ch in checks {
+            ch.metric = format!("{name}: {}", ch.metric);
+            out.push(ch);
+        }
+    }
+    Ok(out)
 }
 
 /// Known failures with their reasons.

@@ -339,3 +339,30 @@ fn bad_input_is_refused() {
         Err(Error::NotConverged { .. })
     ));
 }
+
+#[test]
+fn pack3d_dense_fills_the_requested_domain_at_the_target() {
+    let g = Grading::Uniform { min: 1.0, max: 2.0 };
+    for (b, f) in [
+        (periodic(14.0), 0.63),
+        (
+            Boundary::Walls(Container::walled_box(nalgebra::Vector3::new(
+                16.0, 16.0, 16.0,
+            ))),
+            // 8 d_max wide: the wall layers hold the overall fraction below 0.59
+            0.58,
+        ),
+    ] {
+        let p = pack3d_dense(&b, &g, &Pack3Params::default(), &target(f), 5).expect("dense");
+        assert!(
+            p.fraction >= f - 1e-12 && p.fraction < f + 0.002,
+            "{}",
+            p.fraction
+        );
+        approx::assert_relative_eq!(p.boundary.volume(), b.volume(), max_relative = 1e-12);
+        assert!(brute_overlap(&p.boundary, &p.spheres) <= 1e-12);
+        assert_eq!(p.placed - p.removed, p.spheres.len());
+        // every size within the grading
+        assert!(p.spheres.iter().all(|s| (0.5..=1.0).contains(&s.radius)));
+    }
+}
