@@ -135,6 +135,13 @@ impl Stages {
             note,
         });
     }
+    /// Appends `text` to the note of the last stage called `name`.
+    fn note(&mut self, name: &'static str, text: String) {
+        if let Some(st) = self.0.iter_mut().rev().find(|s| s.name == name) {
+            st.note.push_str("; ");
+            st.note.push_str(&text);
+        }
+    }
     fn skip(&mut self, name: &'static str, reason: &str) {
         self.0.push(Stage {
             name,
@@ -354,7 +361,10 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     let mut grain_stats = None;
     let (container, poses) = if let Some(grains) = &grains {
         let (fixed, auto) = match &scene.container {
-            ContainerSpec::AutoCylinder { solid_fraction } => (None, Some(*solid_fraction)),
+            ContainerSpec::AutoCylinder {
+                solid_fraction,
+                lower_if_needed,
+            } => (None, Some((*solid_fraction, *lower_if_needed))),
             other => (Some(fixed_container(other)), None),
         };
         let pb = crate::progress::spinner("packing grains", quiet);
@@ -369,7 +379,12 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 grains.len(),
                 describe(&gp.container),
                 if gp.tries > 1 {
-                    format!(", auto-sized in {} tries", gp.tries)
+                    format!(
+                        ", auto-sized in {} tries: REQUESTED solid fraction {:.4} NOT REACHED, lowered to {:.4} (lower_if_needed)",
+                        gp.tries,
+                        auto.map_or(0.0, |a| a.0),
+                        s.solid_fraction
+                    )
                 } else {
                     String::new()
                 },
@@ -401,6 +416,39 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         );
         (container, poses)
     };
+
+    // the walls' share of the specimen (issue 28): refuse a narrow container unless asked
+    let d_max = match &grains {
+        Some(g) => g
+            .iter()
+            .map(|g| (6.0 * g.volume() / std::f64::consts::PI).cbrt())
+            .fold(0.0, f64::max),
+        None => to_place
+            .iter()
+            .map(|c| 2.0 * c.bounding_radius)
+            .fold(0.0, f64::max),
+    };
+    let wall = place::wall_share(&container, &poses, d_max);
+    if wall.width < 8.0 * d_max && !scene.allow_narrow_container {
+        bail!(
+            "the container is {:.2} d_max wide (width {:.4}, d_max {:.4}), narrower than 8 d_max: \
+             the walls dominate such a packing ({:.1} % of the grains lie within one d_max of a \
+             wall); use a wider container, or set `allow_narrow_container: true` to accept it",
+            wall.width / d_max,
+            wall.width,
+            d_max,
+            100.0 * wall.near_fraction
+        );
+    }
+    st.note(
+        "place",
+        format!(
+            "container {:.2} d_max wide (d_max {:.4}); grains within one d_max of a wall: {:.1} %",
+            wall.width / d_max,
+            d_max,
+            100.0 * wall.near_fraction
+        ),
+    );
 
     // check
     let t = Instant::now();
@@ -1168,7 +1216,7 @@ fn place_in(
         spec @ (ContainerSpec::Cylinder { .. } | ContainerSpec::Box { .. }) => {
             fixed(fixed_container(spec))
         }
-        ContainerSpec::AutoCylinder { solid_fraction } => {
+        ContainerSpec::AutoCylinder { solid_fraction, .. } => {
             let v: f64 = clones
                 .iter()
                 .map(|c| 4.0 / 3.0 * std::f64::consts::PI * c.bounding_radius.powi(3))

@@ -172,9 +172,10 @@ fn grain_params(preset: Preset, seed: u64) -> GrainPackParams {
 }
 
 /// Packs the clones' star surfaces in `container`, or, for an
-/// `AutoCylinder` (`auto = Some(solid_fraction)`), in triaxial cylinders
-/// sized for that fraction of grain volume, lowered by 5 % per try while
-/// the packer cannot separate the grains.
+/// `AutoCylinder` (`auto = Some((solid_fraction, lower_if_needed))`), in a
+/// triaxial cylinder sized for that fraction of grain volume; with
+/// `lower_if_needed` the fraction is lowered by 5 % per try while the packer
+/// cannot separate the grains (a warning on standard error names both).
 ///
 /// # Errors
 /// No grain; a container smaller than the largest clone's bounding sphere
@@ -183,7 +184,7 @@ fn grain_params(preset: Preset, seed: u64) -> GrainPackParams {
 pub(crate) fn place_grains(
     grains: &[StarGrain],
     container: Option<Container>,
-    auto: Option<f64>,
+    auto: Option<(f64, bool)>,
     preset: Preset,
     seed: u64,
 ) -> anyhow::Result<GrainPlacement> {
@@ -221,14 +222,21 @@ pub(crate) fn place_grains(
             Err(e) => Err(e.into()),
         };
     }
-    let mut fraction = auto.unwrap_or(0.5);
+    let (requested, lower) = auto.unwrap_or((0.5, false));
+    let mut fraction = requested;
     let mut last = String::new();
-    for tries in 1..=FRACTION_TRIES {
+    let tries_allowed = if lower { FRACTION_TRIES } else { 1 };
+    for tries in 1..=tries_allowed {
         let c = container_for(&Container::triaxial(1.0), grains, fraction)?;
         let room = c.inscribed_diameter();
         if largest <= room {
             match pack_grains(grains, &c, &params) {
                 Ok(p) => {
+                    if tries > 1 {
+                        eprintln!(
+                            "specimen: WARNING: AutoCylinder could not separate the clones at the requested solid fraction {requested:.4}; lowered to {fraction:.4} in {tries} tries (lower_if_needed)"
+                        );
+                    }
                     return Ok(GrainPlacement {
                         container: c,
                         poses: p.poses,
@@ -236,7 +244,21 @@ pub(crate) fn place_grains(
                         stats: p.stats,
                     });
                 }
-                Err(e) if too_dense(&e) => last = format!("at solid fraction {fraction:.3}: {e}"),
+                Err(e) if too_dense(&e) => {
+                    last = match e {
+                        // grains at scale λ fill λ³ of their volume
+                        packer_quadtree::Error::NotConverged { scale, .. } if scale < 1.0 => {
+                            format!(
+                                "at solid fraction {fraction:.4} the packer separated the grains only at scale {scale:.4} of their size, i.e. solid fraction {:.4} ({e})",
+                                fraction * scale.powi(3)
+                            )
+                        }
+                        packer_quadtree::Error::NotConverged { .. } => format!(
+                            "at solid fraction {fraction:.4} the grains grew to full size but no overlap-free packing was found ({e})"
+                        ),
+                        _ => format!("at solid fraction {fraction:.4}: {e}"),
+                    };
+                }
                 Err(e) => return Err(e.into()),
             }
         } else {
@@ -246,10 +268,43 @@ pub(crate) fn place_grains(
         }
         fraction *= FRACTION_STEP;
     }
+    if !lower {
+        bail!(
+            "`container`: AutoCylinder cannot reach the requested solid fraction {requested:.4} with these {} clones: {last}; lower `solid_fraction`, or set `lower_if_needed: true` to accept a lower one",
+            grains.len()
+        );
+    }
     bail!(
-        "`container`: AutoCylinder could not separate the {} clones in {FRACTION_TRIES} tries (last {last}); lower `solid_fraction`",
-        grains.len()
+        "`container`: AutoCylinder could not separate the {} clones in {FRACTION_TRIES} tries down to solid fraction {:.4} (last {last}); lower `solid_fraction`",
+        grains.len(),
+        fraction / FRACTION_STEP
     )
+}
+
+/// How much of a specimen the walls hold.
+pub(crate) struct WallShare {
+    /// Horizontal width of the container (cylinder diameter, smaller box side).
+    pub(crate) width: f64,
+    /// Share of the grains whose centre lies within `d_max` of a wall.
+    pub(crate) near_fraction: f64,
+}
+
+/// The container's width and the share of grain centres within `d_max` of
+/// any wall (floor and lid included).
+pub(crate) fn wall_share(c: &Container, poses: &[Isometry3<f64>], d_max: f64) -> WallShare {
+    let width = match c {
+        Container::Cylinder { radius, .. } => 2.0 * radius,
+        Container::Box { min, max, .. } => (max.x - min.x).min(max.y - min.y),
+        _ => c.inscribed_diameter(),
+    };
+    let near = poses
+        .iter()
+        .filter(|p| c.clearance(&nalgebra::Point3::from(p.translation.vector)) < d_max)
+        .count();
+    WallShare {
+        width,
+        near_fraction: near as f64 / poses.len().max(1) as f64,
+    }
 }
 
 /// An isotropic (Haar-uniform) rotation from the `(seed, index)` stream
@@ -307,7 +362,7 @@ mod tests {
     #[test]
     fn grains_are_packed_clean_in_auto_and_fixed_containers() {
         let g = ellipsoids(60);
-        let auto = place_grains(&g, None, Some(0.45), Preset::Default, 3).expect("auto");
+        let auto = place_grains(&g, None, Some((0.45, false)), Preset::Default, 3).expect("auto");
         assert_eq!(auto.poses.len(), g.len());
         assert!((auto.stats.solid_fraction - 0.45).abs() < 1e-9);
         assert_eq!(auto.tries, 1);
@@ -324,8 +379,36 @@ mod tests {
         assert_eq!(format!("{:?}", p.container), format!("{fixed:?}"));
         assert!(p.stats.worst_gap_over_d >= 0.01 * (1.0 - 1e-6));
         // seeded: the same scene gives the same poses
-        let again = place_grains(&g, None, Some(0.45), Preset::Default, 3).expect("auto");
+        let again = place_grains(&g, None, Some((0.45, false)), Preset::Default, 3).expect("auto");
         assert_eq!(again.poses, auto.poses);
+    }
+
+    #[test]
+    fn an_unreachable_auto_fraction_is_an_error_unless_lowering_is_asked() {
+        let g = ellipsoids(60);
+        let e = place_grains(&g, None, Some((0.7, false)), Preset::Default, 1)
+            .err()
+            .expect("0.70 is out of reach")
+            .to_string();
+        assert!(
+            e.contains("cannot reach the requested solid fraction 0.7000")
+                && e.contains("lower_if_needed"),
+            "{e}"
+        );
+        let p = place_grains(&g, None, Some((0.6, true)), Preset::Default, 1).expect("lowered");
+        assert!(p.tries > 1);
+        assert!(p.stats.solid_fraction < 0.6 * 0.95 + 1e-9);
+    }
+
+    #[test]
+    fn wall_share_counts_centres_within_d_max() {
+        let c = Container::triaxial(10.0);
+        let at = |x: f64, z: f64| Isometry3::translation(x, 0.0, z);
+        // radius 5, height 20: x = 4.5 is 0.5 from the side, z = 0.5 from the floor
+        let poses = [at(0.0, 10.0), at(4.5, 10.0), at(0.0, 0.5), at(-2.0, 8.0)];
+        let w = wall_share(&c, &poses, 1.0);
+        assert_eq!(w.width, 10.0);
+        assert_eq!(w.near_fraction, 0.5);
     }
 
     #[test]
@@ -341,7 +424,7 @@ mod tests {
             .expect("too full")
             .to_string();
         assert!(e.contains("cannot take all 60 clones"), "{e}");
-        let e = place_grains(&[], None, Some(0.5), Preset::Default, 1)
+        let e = place_grains(&[], None, Some((0.5, false)), Preset::Default, 1)
             .err()
             .expect("empty")
             .to_string();

@@ -80,6 +80,11 @@ pub(crate) struct Scene {
     pub(crate) length_unit: Option<f64>,
     /// The container.
     pub(crate) container: ContainerSpec,
+    /// Accept a container narrower than 8 d_max (d_max: the largest clone's
+    /// volume-equivalent diameter, or bounding diameter with `BoundingSpheres`),
+    /// where the walls dominate the packing; refused otherwise.
+    #[serde(default)]
+    pub(crate) allow_narrow_container: bool,
     /// How the clones are placed.
     #[serde(default)]
     pub(crate) placement: Placement,
@@ -198,13 +203,18 @@ pub(crate) enum ContainerSpec {
         height: Option<f64>,
     },
     /// A cylinder with H/D = 2 sized so that the clones fill
-    /// `solid_fraction` of it (`Grains`: the grains' volume, lowered by 5 %
-    /// per try while the grain packer cannot separate them, at most 6 tries;
-    /// `BoundingSpheres`: the spheres' volume, the cylinder grown by 5 %
-    /// until every sphere fits).
+    /// `solid_fraction` of it (`Grains`: the grains' volume; when the grain
+    /// packer cannot separate them there, the scene fails naming the
+    /// fraction it reached, unless `lower_if_needed` lets it lower the
+    /// fraction by 5 % per try, at most 6 tries, reported in the stage line
+    /// and on standard error; `BoundingSpheres`: the spheres' volume, the
+    /// cylinder grown by 5 % until every sphere fits).
     AutoCylinder {
         /// Target solid fraction, in (0, 0.7].
         solid_fraction: f64,
+        /// Accept a lower fraction than asked (5 % less per try).
+        #[serde(default)]
+        lower_if_needed: bool,
     },
     /// A walled box `[0, x] × [0, y] × [0, z]`.
     Box {
@@ -392,7 +402,7 @@ impl Scene {
                     positive("container.height", *h)?;
                 }
             }
-            ContainerSpec::AutoCylinder { solid_fraction } => {
+            ContainerSpec::AutoCylinder { solid_fraction, .. } => {
                 if !(*solid_fraction > 0.0 && *solid_fraction <= 0.7) {
                     bail!(
                         "{at}: `container.solid_fraction` must be in (0, 0.7], got {solid_fraction}"

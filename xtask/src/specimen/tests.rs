@@ -46,6 +46,7 @@ fn scene_text(config: &Path, out_dir: &Path, container: &str, outputs: &str) -> 
     clones: Count(20),
     seed: Some(3),
     container: {container},
+    allow_narrow_container: true,
     level_set_resolution: 21,
     outputs: ({outputs}),
     out_dir: "{}",
@@ -606,4 +607,28 @@ fn separate_clumps_leaves_no_overlap_between_clumps_or_with_walls() {
         .expect_err("too deep")
         .to_string();
     assert!(e.contains("spheres per clump"), "{e}");
+}
+
+#[test]
+fn a_narrow_container_is_refused_unless_allowed() {
+    let dir = tmp("narrow");
+    let config = cheap_config(&dir);
+    let text = scene_text(&config, &dir.join("out"), AUTO, "")
+        .replace("    allow_narrow_container: true,\n", "");
+    let e = run(&text)
+        .err()
+        .expect("20 clones make a narrow cylinder")
+        .to_string();
+    assert!(
+        e.contains("narrower than 8 d_max") && e.contains("allow_narrow_container"),
+        "{e}"
+    );
+    assert!(!dir.join("out").exists(), "nothing written");
+    // allowed: the stage report states the width and the walls' share
+    let r = run(&scene_text(&config, &dir.join("ok"), AUTO, "")).expect("allowed");
+    let place = r.text();
+    assert!(
+        place.contains("d_max wide") && place.contains("within one d_max of a wall"),
+        "{place}"
+    );
 }
