@@ -616,8 +616,7 @@ fn a_narrow_container_is_refused_unless_allowed() {
     let text = scene_text(&config, &dir.join("out"), AUTO, "")
         .replace("    allow_narrow_container: true,\n", "");
     let e = run(&text)
-        .err()
-        .expect("20 clones make a narrow cylinder")
+        .expect_err("20 clones make a narrow cylinder")
         .to_string();
     assert!(
         e.contains("narrower than 8 d_max") && e.contains("allow_narrow_container"),
