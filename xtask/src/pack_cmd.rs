@@ -301,7 +301,7 @@ pub(crate) fn parse_grading(s: &str) -> anyhow::Result<Grading> {
                 max,
             }
         }
-        "sieve" => {
+        "sieve" | "sieve-mass" => {
             let (mut sizes, mut passing) = (Vec::new(), Vec::new());
             for pair in rest.split(',') {
                 let (d, p) = pair
@@ -318,10 +318,16 @@ pub(crate) fn parse_grading(s: &str) -> anyhow::Result<Grading> {
                         .with_context(|| format!("passing `{p}`"))?,
                 );
             }
-            Grading::Sieve { sizes, passing }
+            if kind == "sieve-mass" {
+                Grading::sieve_by_mass(sizes, passing)?
+            } else {
+                Grading::Sieve { sizes, passing }
+            }
         }
         _ => {
-            bail!("unknown grading `{kind}` (pinto-3.4, ap5, constant, uniform, lognormal, sieve)")
+            bail!(
+                "unknown grading `{kind}` (pinto-3.4, ap5, constant, uniform, lognormal, sieve, sieve-mass)"
+            )
         }
     };
     g.validate()?;

@@ -107,6 +107,74 @@ impl Grading {
         ])
     }
 
+    /// A sieve curve given as cumulative passing **by mass** (what a
+    /// laboratory reports), as the number distribution the packers draw
+    /// from: a [`Grading::Sieve`] by number, exact at the sieve sizes and
+    /// refined with 32 semi-log points per interval.
+    ///
+    /// Between two sieves the mass passing is interpolated semi-log (mass
+    /// uniform in `ln d`, as the by-number curves), so the number density per
+    /// `ln d` is proportional to `d⁻³` there: the interval `[a, b]` holding
+    /// the mass fraction `Δm` holds the number weight
+    /// `Δm · (a⁻³ − b⁻³) / (3 ln(b / a))`, spread inside it as
+    /// `F(d) = (a⁻³ − d⁻³) / (a⁻³ − b⁻³)`. The sizes are whatever dimension
+    /// the caller maps them to (for grains: the sieve opening that the
+    /// intermediate dimension passes).
+    ///
+    /// # Errors
+    /// As [`Grading::validate`] for the sieve curve.
+    pub fn sieve_by_mass(sizes: Vec<f64>, passing: Vec<f64>) -> Result<Self> {
+        const SUB: usize = 32;
+        let mass = Self::Sieve { sizes, passing };
+        mass.validate()?;
+        let Self::Sieve { sizes, passing } = mass else {
+            unreachable!("constructed above")
+        };
+        let n = sizes.len();
+        let weight: Vec<f64> = (0..n - 1)
+            .map(|i| {
+                let (a, b) = (sizes[i], sizes[i + 1]);
+                let dm = passing[i + 1] - passing[i];
+                if dm > 0.0 {
+                    dm * (a.powi(-3) - b.powi(-3)) / (3.0 * (b / a).ln())
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let total: f64 = weight.iter().sum();
+        let mut out_sizes = vec![sizes[0]];
+        let mut out_pass = vec![0.0];
+        let mut acc = 0.0;
+        for i in 0..n - 1 {
+            let (a, b) = (sizes[i], sizes[i + 1]);
+            for j in 1..=SUB {
+                let d = if j == SUB {
+                    b
+                } else {
+                    a * (b / a).powf(j as f64 / SUB as f64)
+                };
+                let f = (a.powi(-3) - d.powi(-3)) / (a.powi(-3) - b.powi(-3));
+                out_sizes.push(d);
+                out_pass.push(100.0 * (acc + weight[i] * f) / total);
+            }
+            acc += weight[i];
+        }
+        // round-off: the curve ends at exactly 100
+        if let Some(last) = out_pass.last_mut() {
+            *last = 100.0;
+        }
+        for k in 1..out_pass.len() {
+            out_pass[k] = out_pass[k].max(out_pass[k - 1]).min(100.0);
+        }
+        let g = Self::Sieve {
+            sizes: out_sizes,
+            passing: out_pass,
+        };
+        g.validate()?;
+        Ok(g)
+    }
+
     /// Checks every invariant of the variant.
     ///
     /// # Errors
@@ -659,6 +727,41 @@ mod tests {
         }
         assert_relative_eq!(g.d_min(), 1.2);
         assert_relative_eq!(g.d_max(), 1.295);
+    }
+
+    /// A lab's mass-passing curve turned into a number distribution gives the
+    /// same mass passing back at every sieve (the report's mass curve of the
+    /// number distribution), and far more small grains by number.
+    #[test]
+    fn sieve_by_mass_round_trips_the_mass_passing() {
+        let sizes = vec![0.1, 0.15, 0.25, 0.425, 0.6];
+        let passing = vec![0.0, 8.0, 45.0, 90.0, 100.0];
+        let g = Grading::sieve_by_mass(sizes.clone(), passing.clone()).expect("valid");
+        let m = MassCurve::new(&g);
+        for (d, p) in sizes.iter().zip(&passing) {
+            assert!(
+                (100.0 * m.passing(*d) - p).abs() < 0.05,
+                "{d}: {}",
+                100.0 * m.passing(*d)
+            );
+        }
+        // by number the finest interval holds 8 % of the mass but 39.4 % of the grains:
+        // 8 (10³ − 0.15⁻³) / (3 ln 1.5) over the sum of the four intervals' weights
+        let w = |a: f64, b: f64, dm: f64| dm * (a.powi(-3) - b.powi(-3)) / (3.0 * (b / a).ln());
+        let first = w(0.1, 0.15, 8.0);
+        let all = first + w(0.15, 0.25, 37.0) + w(0.25, 0.425, 45.0) + w(0.425, 0.6, 10.0);
+        assert_relative_eq!(g.passing_at(0.15), first / all, epsilon = 1e-12);
+        assert!(first / all > 0.39);
+        assert_relative_eq!(g.d_min(), 0.1);
+        assert_relative_eq!(g.d_max(), 0.6);
+        // flat intervals (no mass) stay empty; bad curves are errors
+        let flat = Grading::sieve_by_mass(vec![1.0, 2.0, 3.0, 4.0], vec![0.0, 50.0, 50.0, 100.0])
+            .expect("flat middle");
+        assert_relative_eq!(flat.passing_at(2.0), flat.passing_at(3.0), epsilon = 1e-12);
+        assert!(Grading::sieve_by_mass(vec![1.0, 2.0], vec![0.0, 90.0]).is_err());
+        assert!(Grading::sieve_by_mass(vec![2.0, 1.0], vec![0.0, 100.0]).is_err());
+        assert!(Grading::sieve_by_mass(vec![1.0, f64::NAN], vec![0.0, 100.0]).is_err());
+        assert!(Grading::sieve_by_mass(vec![1.0, 2.0, 3.0], vec![0.0, 100.0]).is_err());
     }
 
     #[test]

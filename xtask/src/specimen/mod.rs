@@ -307,14 +307,18 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         |c: &cloner::ClonedGrain| (6.0 * c.surface.volume / std::f64::consts::PI).cbrt();
     let scales: Vec<f64> = match &scene.clones {
         Clones::Count(_) => vec![1.0; run.clones.len()],
-        Clones::Graded { grading, .. } => {
+        Clones::Graded { grading, size, .. } => {
             let g = crate::pack_cmd::parse_grading(grading)?;
             run.clones
                 .iter()
                 .map(|c| {
                     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ SIZE_STREAM);
                     rng.set_stream(c.index);
-                    g.diameter_at(rng.random::<f64>()) / equivalent(c)
+                    size.scale(
+                        g.diameter_at(rng.random::<f64>()),
+                        c.surface.volume,
+                        c.surface.dims,
+                    )
                 })
                 .collect()
         }

@@ -171,14 +171,41 @@ pub(crate) enum ParentsSpec {
 pub(crate) enum Clones {
     /// `count` clones at the sizes the cloner draws (the parents' sizes).
     Count(u64),
-    /// `count` clones, each rescaled to a volume-equivalent diameter drawn
-    /// (by number) from `grading` (`cargo xtask pack --grading` syntax).
+    /// `count` clones, each rescaled so that its `size` measure is a size
+    /// drawn (by number) from `grading` (`cargo xtask pack --grading`
+    /// syntax; `sieve-mass:SIZE:PASSING,…` is a lab's curve by mass).
     Graded {
         /// Number of clones.
         count: u64,
         /// The grading, e.g. `"uniform:20,40"`.
         grading: String,
+        /// What a drawn size is (default the volume-equivalent diameter).
+        #[serde(default)]
+        size: SizeMeasure,
     },
+}
+
+/// The grain dimension a grading's sizes stand for.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+pub(crate) enum SizeMeasure {
+    /// The volume-equivalent diameter `(6 V / π)^(1/3)`.
+    #[default]
+    Equivalent,
+    /// The intermediate principal dimension `I` (of the volume-scaled
+    /// inertia-equivalent ellipsoid): a grain passes a square sieve opening
+    /// `s` when `I ≤ s`, the usual reading of a sieve analysis.
+    Intermediate,
+}
+
+impl SizeMeasure {
+    /// Scale that gives a grain of volume `volume` and principal dimensions
+    /// `dims = [L, I, S]` the size `drawn` in this measure.
+    pub(crate) fn scale(self, drawn: f64, volume: f64, dims: [f64; 3]) -> f64 {
+        match self {
+            Self::Equivalent => drawn / (6.0 * volume / std::f64::consts::PI).cbrt(),
+            Self::Intermediate => drawn / dims[1],
+        }
+    }
 }
 
 impl Clones {

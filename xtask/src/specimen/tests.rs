@@ -631,3 +631,24 @@ fn a_narrow_container_is_refused_unless_allowed() {
         "{place}"
     );
 }
+
+#[test]
+fn a_sieve_curve_by_mass_sizes_the_intermediate_dimension() {
+    use super::scene::SizeMeasure;
+    // the measure's scale gives the grain the drawn size
+    let dims = [3.0, 2.0, 1.0];
+    let v = std::f64::consts::PI / 6.0 * 8.0; // d_eq = 2
+    assert!((SizeMeasure::Intermediate.scale(5.0, v, dims) * dims[1] - 5.0).abs() < 1e-12);
+    assert!((SizeMeasure::Equivalent.scale(5.0, v, dims) * 2.0 - 5.0).abs() < 1e-12);
+    // a scene with a lab's curve by mass runs, every grain's scale from its own I
+    let dir = tmp("sieve-mass");
+    let config = cheap_config(&dir);
+    let text = scene_text(&config, &dir.join("out"), AUTO, "").replace(
+        "clones: Count(20),",
+        "clones: Graded(count: 20, grading: \"sieve-mass:150:0,250:40,425:100\", size: Intermediate),",
+    );
+    run(&text).expect("sieve-mass scene");
+    let bad = text.replace("425:100", "425:90");
+    let e = run(&bad).expect_err("passing must end at 100").to_string();
+    assert!(e.contains("grading"), "{e}");
+}
