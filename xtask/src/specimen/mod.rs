@@ -889,10 +889,11 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                     name,
                     t,
                     format!(
-                        "{} files: {name}/ settle deck (Hertz-Mindlin E/{}, union mass and inertia, dt {:.3e} s = Hertz time of the smallest clump / 20, at most {} steps, self-checks: bodies, KE <= {:.3e} J, overlap <= 0.01 d50, bed fraction within 0.01 of {:.4}) + settle.txt",
+                        "{} files: {name}/ settle deck (Hertz-Mindlin E/{}, union mass and inertia, dt {:.3e} s = Hertz time of the smallest clump / {}, at most {} steps, self-checks: bodies, KE <= {:.3e} J, overlap <= 0.01 d50, bed fraction within 0.01 of {:.4}) + settle.txt",
                         files.len() + 1,
                         material.stiffness_scale,
                         plan.dt,
+                        dem::STEPS_PER_CONTACT,
                         plan.max_steps,
                         plan.ke_limit,
                         plan.packed_fraction

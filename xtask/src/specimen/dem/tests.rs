@@ -121,7 +121,7 @@ fn hertz_time_step_matches_the_closed_form() {
     assert_relative_eq!(t, 2.87 * 4.0, max_relative = 1e-12);
     let t = hertz_contact_time(1.0, 32.0, 1.0, 32.0);
     assert_relative_eq!(t, 2.87 / 4.0, max_relative = 1e-12);
-    // the plan's step is t_H / 20 of the lightest clump at the smallest sphere
+    // the plan's step is t_H / STEPS_PER_CONTACT of the lightest clump at the smallest sphere
     let t = [pair()];
     let b = bodies(1, 3);
     let mat = Material::default();
@@ -137,7 +137,7 @@ fn hertz_time_step_matches_the_closed_form() {
     let m = mat.density * PI / 6.0 * d.powi(3);
     let e = mat.youngs() / (2.0 * (1.0 - 0.04));
     let th = hertz_contact_time(0.5 * m, 0.5e-4, e, (2.0 * 9.81 * d).sqrt());
-    assert_relative_eq!(p.dt, th / 20.0, max_relative = 1e-12);
+    assert_relative_eq!(p.dt, th / STEPS_PER_CONTACT, max_relative = 1e-12);
     assert_relative_eq!(p.ke_limit, 1e-6 * 3.0 * m * 9.81 * d, max_relative = 1e-9);
     assert!(p.min_steps >= p.chunk && p.max_steps > p.min_steps);
     // quartz at E/100: a few 1e-7 s for 0.2 mm sand (Rayleigh of the sphere is shorter)
