@@ -170,13 +170,7 @@ impl Run3<'_> {
         let t2 = Instant::now();
         let report = metrics_report(&container, &self.grading, &p.spheres)?;
         let t_check = t2.elapsed().as_secs_f64();
-        let t3 = Instant::now();
-        let files = self.files(&p.spheres, &container, false)?;
-        let dir = root.join(&self.out);
-        for (path, bytes) in &files {
-            write_atomic(&root.join(path), bytes)?;
-        }
-        let t_write = t3.elapsed().as_secs_f64();
+        let t_write = self.write(root, &p.spheres, &container, false)?;
         let mut text = report;
         let n = p.spheres.len() as f64;
         let _ = writeln!(
@@ -199,10 +193,7 @@ impl Run3<'_> {
             p.stats.sizes_skipped,
             p.stats.peak_bytes as f64 / 1e6
         );
-        write_atomic(&dir.join("report.txt"), text.as_bytes())?;
-        print!("{text}");
-        println!("written to {}", dir.display());
-        Ok(())
+        self.publish(root, &text)
     }
 
     fn params(&self) -> Pack3Params {
@@ -283,13 +274,7 @@ impl Run3<'_> {
             other => bail!("unsupported densification domain {other:?}"),
         };
         let t_check = t2.elapsed().as_secs_f64();
-        let t3 = Instant::now();
-        let files = self.files(&p.spheres, &container, fully)?;
-        let dir = root.join(&self.out);
-        for (path, bytes) in &files {
-            write_atomic(&root.join(path), bytes)?;
-        }
-        let t_write = t3.elapsed().as_secs_f64();
+        let t_write = self.write(root, &p.spheres, &container, fully)?;
         let mut text = report;
         let n = p.spheres.len() as f64;
         let _ = writeln!(
@@ -316,6 +301,27 @@ impl Run3<'_> {
              check and metrics {t_check:.3} s, write {t_write:.3} s",
             n / t_pack.max(1e-9)
         );
+        self.publish(root, &text)
+    }
+
+    /// Writes the output files atomically; returns the seconds it took.
+    fn write(
+        &self,
+        root: &Path,
+        spheres: &[Sphere],
+        container: &Container,
+        fully: bool,
+    ) -> anyhow::Result<f64> {
+        let t = Instant::now();
+        for (path, bytes) in &self.files(spheres, container, fully)? {
+            write_atomic(&root.join(path), bytes)?;
+        }
+        Ok(t.elapsed().as_secs_f64())
+    }
+
+    /// Writes `report.txt` and prints it.
+    fn publish(&self, root: &Path, text: &str) -> anyhow::Result<()> {
+        let dir = root.join(&self.out);
         write_atomic(&dir.join("report.txt"), text.as_bytes())?;
         print!("{text}");
         println!("written to {}", dir.display());

@@ -413,24 +413,7 @@ pub fn pack3d_dense(
     dense.validate()?;
     grading.validate()?;
     let want = Geom::new(boundary)?;
-    let front_container = |s: f64| -> Container {
-        match want.scaled(s) {
-            Geom::Box { lo, hi, periodic } => Container::Box {
-                min: Point3::from(lo),
-                max: Point3::from(hi),
-                periodic: [periodic[0], periodic[1]],
-            },
-            Geom::Cylinder {
-                centre,
-                radius,
-                height,
-            } => Container::Cylinder {
-                base: Point3::new(centre[0], centre[1], centre[2] - 0.5 * height),
-                radius,
-                height,
-            },
-        }
-    };
+    let front_container = |s: f64| want.scaled(s).container();
     let volume = want.volume();
     let f = match dense.target {
         Target::Fraction(f) => f,
@@ -481,16 +464,7 @@ pub fn pack3d_dense(
             .filter(|(_, k)| **k)
             .map(|(s, _)| *s)
             .collect();
-        let enlarged = match boundary {
-            Boundary::Periodic { .. } => {
-                let (lo, hi) = want.scaled(scale).bounds();
-                Boundary::Periodic {
-                    min: Point3::from(lo),
-                    max: Point3::from(hi),
-                }
-            }
-            Boundary::Walls(_) => Boundary::Walls(front_container(scale)),
-        };
+        let enlarged = want.scaled(scale).boundary(boundary);
         let exact = left / volume;
         let d = densify(
             &spheres,
@@ -804,26 +778,32 @@ impl Geom {
                 min: Point3::from(lo),
                 max: Point3::from(hi),
             },
-            (Self::Box { lo, hi, periodic }, _) => Boundary::Walls(Container::Box {
+            _ => Boundary::Walls(self.container()),
+        }
+    }
+
+    /// The container of this geometry (a box keeps its x/y periodicity and
+    /// has walls in z: what the front packs).
+    fn container(&self) -> Container {
+        match *self {
+            Self::Box { lo, hi, periodic } => Container::Box {
                 min: Point3::from(lo),
                 max: Point3::from(hi),
                 periodic: [periodic[0], periodic[1]],
-            }),
-            (
-                Self::Cylinder {
-                    centre,
-                    radius,
-                    height,
-                },
-                _,
-            ) => Boundary::Walls(Container::Cylinder {
+            },
+            Self::Cylinder {
+                centre,
+                radius,
+                height,
+            } => Container::Cylinder {
                 base: Point3::new(centre[0], centre[1], centre[2] - 0.5 * height),
                 radius,
                 height,
-            }),
+            },
         }
     }
 }
+
 /// Spheres per chunk of the deterministic global sums.
 const CHUNK: usize = 1024;
 /// Bits of a neighbour entry holding the sphere index; the 5 bits above hold the
@@ -917,15 +897,10 @@ impl System {
         self.built = false;
     }
 
-    /// Scales the domain and the centres by `s` about the domain's centre.
+    /// Scales the domain and the centres by `s` about the domain's centre,
+    /// forgetting the velocities.
     fn compress(&mut self, s: f64) {
-        let c = self.geom.centre();
-        for p in &mut self.xr {
-            for k in 0..3 {
-                p[k] = c[k] + s * (p[k] - c[k]);
-            }
-        }
-        self.geom = self.geom.scaled(s);
+        self.scale_keep(s);
         self.reset();
     }
 
@@ -1296,15 +1271,7 @@ impl System {
             })
             .reduce(|| 0.0, f64::max);
         if delta > 0.0 {
-            let s = (1.0 + delta) * (1.0 + 4.0 * f64::EPSILON);
-            let c = self.geom.centre();
-            for p in &mut self.xr {
-                for k in 0..3 {
-                    p[k] = c[k] + s * (p[k] - c[k]);
-                }
-            }
-            self.geom = self.geom.scaled(s);
-            self.built = false;
+            self.scale_keep((1.0 + delta) * (1.0 + 4.0 * f64::EPSILON));
         }
     }
 
