@@ -86,7 +86,10 @@
 //! a fixed order, so the packing is identical for any thread count.
 
 mod check;
+mod compact;
 mod relax;
+
+pub use compact::CompactStats;
 
 pub use check::{CheckParams, GrainOverlapReport, check_grain_overlaps};
 
@@ -243,6 +246,9 @@ impl StarGrain {
     }
 }
 
+/// Most proxy spheres per grain [`GrainPackParams::proxy_spheres`] takes.
+pub const MAX_PROXY_SPHERES: usize = 1024;
+
 /// Parameters of [`pack_grains`] (plain data, validated at entry).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GrainPackParams {
@@ -276,6 +282,14 @@ pub struct GrainPackParams {
     /// look-ahead of 64 sizes, so that a wide grading's large sizes find
     /// room before the front ends).
     pub skeleton: Pack3Params,
+    /// Tangent spheres per grain of the proxies that the compaction stage
+    /// grows to full size by FIRE (step 3a of the module docs), or 0 for
+    /// the seed's growth by the gap minimisation alone.
+    pub proxy_spheres: usize,
+    /// Clearance added to every proxy sphere, over the grain's `d_eq`.
+    pub proxy_inflate: f64,
+    /// FIRE iterations per growth step of the compaction.
+    pub proxy_iterations: usize,
 }
 
 impl Default for GrainPackParams {
@@ -293,6 +307,9 @@ impl Default for GrainPackParams {
                 lookahead: 64,
                 ..Pack3Params::default()
             },
+            proxy_spheres: 48,
+            proxy_inflate: 0.015,
+            proxy_iterations: 5000,
         }
     }
 }
@@ -321,6 +338,15 @@ impl GrainPackParams {
         }
         if !(self.relaxation > 0.0 && self.relaxation < 2.0) {
             return bad("relaxation", self.relaxation, "(0, 2)");
+        }
+        if self.proxy_spheres > MAX_PROXY_SPHERES {
+            return bad("proxy_spheres", self.proxy_spheres as f64, "[0, 1024]");
+        }
+        if !(self.proxy_inflate.is_finite() && (0.0..0.1).contains(&self.proxy_inflate)) {
+            return bad("proxy_inflate", self.proxy_inflate, "[0, 0.1)");
+        }
+        if self.proxy_iterations == 0 {
+            return bad("proxy_iterations", 0.0, "[1, inf)");
         }
         self.skeleton.validate()
     }
@@ -356,6 +382,8 @@ pub struct GrainPackStats {
     /// Scale of the grains at the start of the growth (every grain inside
     /// its skeleton sphere).
     pub growth_start: f64,
+    /// Counters of the compaction stage (zero without it).
+    pub compaction: CompactStats,
 }
 
 /// A packing of grains: one body→world pose per input grain, same order.
@@ -492,9 +520,29 @@ pub fn pack_grains(
             0.5 * scale * ((1.0 - beta) * g.equivalent_diameter() + beta * 2.0 * g.r_max) / g.r_max
         })
         .fold(1.0_f64, f64::min);
+    let (mut centres, mut rotations) = (centres, rotations);
+    let mut lam_relax = lam0;
+    if params.proxy_spheres > 0 {
+            let proxy = compact::build(grains, params.proxy_spheres);
+        stats.compaction = compact::compact(
+            grains,
+            &proxy,
+            container,
+            &mut centres,
+            &mut rotations,
+            lam0,
+            &compact::CompactParams {
+                inflate: params.proxy_inflate,
+                tolerance: 5e-3,
+                max_iterations: params.proxy_iterations,
+            },
+        )?;
+        lam_relax = 1.0;
+    }
     let (centres, rotations) = relax::relax(
-        grains, container, &rotations, centres, lam0, params, &mut stats,
+        grains, container, &rotations, centres, lam_relax, params, &mut stats,
     )?;
+    stats.growth_start = lam0;
     let poses = centres
         .iter()
         .zip(&rotations)

@@ -1,0 +1,878 @@
+//! Compaction of a grain skeleton by FIRE on sphere proxies: each grain is
+//! a rigid clump of spheres inscribed in its star surface, the clumps grow
+//! from the skeleton's scale to full size while FIRE removes the overlaps of
+//! spheres of different grains (see the parent module, step 3a).
+
+use nalgebra::{Matrix3, Point3, UnitQuaternion, Vector3};
+use rayon::prelude::*;
+
+use super::StarGrain;
+#[cfg(test)]
+use super::fibonacci;
+use crate::error::{Error, Result};
+use crate::pack3d::Container;
+
+/// Spheres per chunk of the parallel passes (fixed, so sums are added in
+/// the same order for any thread count).
+const CHUNK: usize = 1024;
+
+/// Largest tangent-sphere radius of a proxy, over the grain's `r_eq`.
+const RHO_MAX: f64 = 0.8;
+
+/// Smallest proxy sphere kept, over the grain's `r_eq`.
+const RHO_MIN: f64 = 0.08;
+
+/// The proxy is complete when every surface point is this close to it,
+/// over the grain's `r_eq`.
+const DEFICIT: f64 = 0.01;
+
+/// How far a proxy sphere may stand out of the surface, over `r_eq`
+/// (rough surfaces would otherwise take only small spheres).
+const PROTRUDE: f64 = 0.04;
+
+/// Largest growth step of the compaction (relative scale).
+const MAX_GROWTH: f64 = 0.15;
+
+/// Smallest growth step before the compaction gives up.
+const MIN_GROWTH: f64 = 2e-3;
+
+/// A grain's surface points used to measure inscribed distances: the
+/// vertices of its table at this many cells per face (bisection), then
+/// at 16 (the final radius).
+const COARSE_FACE_CELLS: usize = 6;
+const FINE_FACE_CELLS: usize = 16;
+
+/// Rigid clumps of spheres inscribed in the grains (body frames).
+pub(super) struct Proxy {
+    /// Body-frame centre of each sphere.
+    off: Vec<Vector3<f64>>,
+    /// Radius of each sphere.
+    rad: Vec<f64>,
+    /// `start[i]..start[i + 1]`: the spheres of grain `i`.
+    start: Vec<usize>,
+    /// `groups[i·CLUSTERS + k]..groups[i·CLUSTERS + k + 1]`: the spheres of
+    /// cluster `k` of grain `i` (its spheres sorted by the octant of their
+    /// centre), with `bounds[i·CLUSTERS + k]`: body-frame centre and radius
+    /// of a sphere holding the cluster's spheres.
+    groups: Vec<usize>,
+    bounds: Vec<(Vector3<f64>, f64)>,
+}
+
+/// Clusters per grain: the octants of the body frame.
+const CLUSTERS: usize = 8;
+
+impl Proxy {
+    /// Spheres in all.
+    pub(super) fn len(&self) -> usize {
+        self.rad.len()
+    }
+
+    /// Volume fraction of grain `i` the union covers, estimated on
+    /// `dirs` × 16 radial samples (tests and stats).
+    #[cfg(test)]
+    pub(super) fn coverage(&self, i: usize, g: &StarGrain, dirs: &[Vector3<f64>]) -> f64 {
+        let (a, b) = (self.start[i], self.start[i + 1]);
+        let mut inside = 0.0;
+        let mut total = 0.0;
+        for u in dirs {
+            let r = g.radius(u);
+            for k in 0..16 {
+                // radial samples at equal volume shells
+                let t = ((k as f64 + 0.5) / 16.0).cbrt();
+                let p = u * (t * r);
+                total += 1.0;
+                if (a..b).any(|s| (p - self.off[s]).norm() < self.rad[s]) {
+                    inside += 1.0;
+                }
+            }
+        }
+        inside / total
+    }
+}
+
+/// Surface points `r(u)·u` of `g` at the cube-map vertices of `face_cells`.
+fn surface(g: &StarGrain, face_cells: usize) -> Vec<Vector3<f64>> {
+    levelset::cube_map_directions(face_cells)
+        .map(|d| d.into_iter().map(|u| u.into_inner() * g.radius(&u)).collect())
+        .unwrap_or_default()
+}
+
+/// Distance from `p` to the nearest of `pts`.
+fn nearest(pts: &[Vector3<f64>], p: &Vector3<f64>) -> f64 {
+    pts.iter()
+        .map(|s| (s - p).norm_squared())
+        .fold(f64::INFINITY, f64::min)
+        .sqrt()
+}
+
+/// Outward normal of the star surface at direction `u` (gradient of
+/// `|x| − r(x̂)` by central differences; `u` where it degenerates).
+fn normal(g: &StarGrain, u: &Vector3<f64>) -> Vector3<f64> {
+    let x = u * g.radius(u);
+    let h = 1e-3 * g.r_max();
+    let mut grad = Vector3::zeros();
+    for k in 0..3 {
+        let mut a = x;
+        let mut b = x;
+        a[k] += h;
+        b[k] -= h;
+        grad[k] = (a.norm() - g.radius(&a) - b.norm() + g.radius(&b)) / (2.0 * h);
+    }
+    let len = grad.norm();
+    if len.is_finite() && len > 0.0 {
+        grad / len
+    } else {
+        *u
+    }
+}
+
+/// The proxy of one grain: a central sphere, then greedily (up to
+/// `per_grain` more) the largest sphere (up to `RHO_MAX · r_eq`) tangent
+/// from inside at the surface point the union reaches least, until every
+/// surface point is within `DEFICIT · r_eq` of the union.
+fn grain_proxy(g: &StarGrain, per_grain: usize) -> Vec<(Vector3<f64>, f64)> {
+    let coarse = surface(g, COARSE_FACE_CELLS);
+    let fine = surface(g, FINE_FACE_CELLS);
+    let r_eq = 0.5 * g.equivalent_diameter();
+    let mut out = Vec::with_capacity(per_grain + 1);
+    let c0 = nearest(&fine, &Vector3::zeros());
+    out.push((Vector3::zeros(), c0));
+    let mut deficit: Vec<f64> = fine.iter().map(|s| s.norm() - c0).collect();
+    let mut done = vec![false; fine.len()];
+    while out.len() <= per_grain {
+        let mut best = (f64::NEG_INFINITY, 0);
+        for (k, &d) in deficit.iter().enumerate() {
+            if !done[k] && d > best.0 {
+                best = (d, k);
+            }
+        }
+        if best.0 < DEFICIT * r_eq {
+            break;
+        }
+        done[best.1] = true;
+        let s = fine[best.1];
+        let u = s.normalize();
+        let n = normal(g, &u);
+        // largest ρ with the sphere at s − ρn clear of the surface points
+        let fits = |rho: f64| nearest(&coarse, &(s - rho * n)) + PROTRUDE * r_eq >= rho;
+        let (mut lo, mut hi) = (RHO_MIN * r_eq, RHO_MAX * r_eq);
+        if fits(hi) {
+            lo = hi;
+        } else {
+            for _ in 0..8 {
+                let mid = 0.5 * (lo + hi);
+                if fits(mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+        }
+        let p = s - lo * n;
+        // inscribed at p (the fine surface points, minus their sagitta)
+        let rad = (nearest(&fine, &p) + PROTRUDE * r_eq).min(lo);
+        if rad > RHO_MIN * r_eq && p.norm() < g.radius(&p) {
+            for (d, x) in deficit.iter_mut().zip(&fine) {
+                *d = d.min((x - p).norm() - rad);
+            }
+            out.push((p, rad));
+        }
+    }
+    out
+}
+
+/// Proxies of every grain with `per_grain` tangent spheres each.
+pub(super) fn build(grains: &[StarGrain], per_grain: usize) -> Proxy {
+    let per: Vec<Vec<(Vector3<f64>, f64)>> = grains
+        .par_iter()
+        .with_min_len(16)
+        .map(|g| grain_proxy(g, per_grain))
+        .collect();
+    let mut proxy = Proxy {
+        off: Vec::new(),
+        rad: Vec::new(),
+        start: vec![0],
+        groups: Vec::with_capacity(grains.len() * CLUSTERS + 1),
+        bounds: Vec::with_capacity(grains.len() * CLUSTERS),
+    };
+    let octant = |o: &Vector3<f64>| {
+        usize::from(o.x >= 0.0) | usize::from(o.y >= 0.0) << 1 | usize::from(o.z >= 0.0) << 2
+    };
+    for (g, mut spheres) in grains.iter().zip(per) {
+        if spheres.is_empty() {
+            // a degenerate table: its inscribed sphere at the origin
+            spheres.push((Vector3::zeros(), g.r_min().max(f64::MIN_POSITIVE)));
+        }
+        spheres.sort_by_key(|(o, _)| octant(o));
+        let base = proxy.off.len();
+        for k in 0..CLUSTERS {
+            let first = base + spheres.iter().filter(|(o, _)| octant(o) < k).count();
+            proxy.groups.push(first);
+            let members: Vec<&(Vector3<f64>, f64)> =
+                spheres.iter().filter(|(o, _)| octant(o) == k).collect();
+            let centre = if members.is_empty() {
+                Vector3::zeros()
+            } else {
+                members.iter().map(|(o, _)| o).sum::<Vector3<f64>>() / members.len() as f64
+            };
+            let radius = members
+                .iter()
+                .map(|(o, r)| (o - centre).norm() + r)
+                .fold(-1.0, f64::max);
+            proxy.bounds.push((centre, radius));
+        }
+        for (o, r) in spheres {
+            proxy.off.push(o);
+            proxy.rad.push(r);
+        }
+        proxy.start.push(proxy.off.len());
+    }
+    proxy.groups.push(proxy.off.len());
+    proxy
+}
+
+/// Parameters of [`compact`].
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CompactParams {
+    /// Extra clearance of every proxy sphere of grain `i`: `inflate · d_eq(i)`.
+    pub inflate: f64,
+    /// Largest overlap left (of inflated spheres), over the smallest `d_eq`.
+    pub tolerance: f64,
+    /// FIRE iterations per growth step.
+    pub max_iterations: usize,
+}
+
+/// Counters of a compaction.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CompactStats {
+    /// Proxy spheres in all.
+    pub spheres: usize,
+    /// Growth steps that relaxed.
+    pub steps_accepted: usize,
+    /// Growth steps undone.
+    pub steps_rejected: usize,
+    /// FIRE iterations.
+    pub iterations: usize,
+    /// Neighbour-list builds.
+    pub neighbour_builds: usize,
+}
+
+/// Partial sums of one chunk of bodies.
+#[derive(Clone, Copy, Default)]
+struct Sums {
+    power: f64,
+    ff: f64,
+    uu: f64,
+}
+
+struct System<'a> {
+    proxy: &'a Proxy,
+    container: &'a Container,
+    /// Sphere → body.
+    body: Vec<u32>,
+    c: Vec<Vector3<f64>>,
+    q: Vec<UnitQuaternion<f64>>,
+    rot: Vec<Matrix3<f64>>,
+    /// Generalised velocity `(v, k·ω)` of each body.
+    u: Vec<[f64; 6]>,
+    /// Radius of gyration of each body.
+    k: Vec<f64>,
+    /// Absolute inflation of each body's spheres.
+    eps: Vec<f64>,
+    lam: f64,
+    /// Sphere world centres and effective radii.
+    x: Vec<[f64; 4]>,
+    f: Vec<[f64; 3]>,
+    start: Vec<u32>,
+    list: Vec<u32>,
+    /// Sphere centres at the last build.
+    x_build: Vec<[f64; 4]>,
+    /// Whether a sphere was within the skin of a wall at the last build.
+    walled: Vec<bool>,
+    skin: f64,
+    tol: f64,
+    built: bool,
+}
+
+impl System<'_> {
+    fn place(&mut self) {
+        let (proxy, c, rot, eps, lam) = (self.proxy, &self.c, &self.rot, &self.eps, self.lam);
+        let body = &self.body;
+        self.x
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(ch, xs)| {
+                for (o, x) in xs.iter_mut().enumerate() {
+                    let s = ch * CHUNK + o;
+                    let b = body[s] as usize;
+                    let p = c[b] + rot[b] * (lam * proxy.off[s]);
+                    *x = [p.x, p.y, p.z, lam * proxy.rad[s] + eps[b]];
+                }
+            });
+    }
+
+    /// Builds the sphere neighbour lists (pairs of spheres of different
+    /// grains closer than `r_s + r_t + skin`) from the pairs of grains whose
+    /// bounding spheres are that close, each side culled to its spheres
+    /// near the other grain.
+    fn build(&mut self) {
+        self.place();
+        let n = self.c.len();
+        let (proxy, x, c, skin) = (self.proxy, &self.x, &self.c, self.skin);
+        let (rot, eps, lam) = (&self.rot, &self.eps, self.lam);
+        // bounding radius of each grain's spheres
+        let bound: Vec<f64> = (0..n)
+            .map(|b| {
+                (proxy.start[b]..proxy.start[b + 1])
+                    .map(|s| {
+                        let p = Vector3::new(x[s][0], x[s][1], x[s][2]);
+                        (p - c[b]).norm() + x[s][3]
+                    })
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        let (lo, hi) = self.container.bbox();
+        let reach = 2.0 * bound.iter().copied().fold(0.0, f64::max) + skin;
+        let mut dims = [1usize; 3];
+        let mut side = [0.0; 3];
+        for k in 0..3 {
+            let l = hi[k] - lo[k];
+            dims[k] = ((l / reach).floor() as usize).clamp(1, 1 << 10);
+            side[k] = l / dims[k] as f64;
+        }
+        let cell_of = |p: &Vector3<f64>| -> [usize; 3] {
+            let mut q = [0usize; 3];
+            for k in 0..3 {
+                let i = ((p[k] - lo[k]) / side[k]).floor();
+                q[k] = if i.is_nan() || i < 0.0 {
+                    0
+                } else {
+                    (i as usize).min(dims[k] - 1)
+                };
+            }
+            q
+        };
+        let ncell = dims[0] * dims[1] * dims[2];
+        let mut head = vec![0u32; ncell + 1];
+        let cells: Vec<usize> = c
+            .iter()
+            .map(|p| {
+                let q = cell_of(p);
+                (q[2] * dims[1] + q[1]) * dims[0] + q[0]
+            })
+            .collect();
+        for &q in &cells {
+            head[q + 1] += 1;
+        }
+        for i in 0..ncell {
+            head[i + 1] += head[i];
+        }
+        let mut fill = head.clone();
+        let mut order = vec![0u32; n];
+        for (i, &q) in cells.iter().enumerate() {
+            order[fill[q] as usize] = i as u32;
+            fill[q] += 1;
+        }
+        // per grain: its spheres' lists (flat) and their lengths
+        let lists: Vec<(Vec<u32>, Vec<u32>)> = (0..n)
+            .into_par_iter()
+            .with_min_len(16)
+            .map(|i| {
+                let mine = proxy.start[i]..proxy.start[i + 1];
+                let q = cell_of(&c[i]);
+                let mut others: Vec<usize> = Vec::with_capacity(32);
+                for cz in q[2].saturating_sub(1)..=(q[2] + 1).min(dims[2] - 1) {
+                    for cy in q[1].saturating_sub(1)..=(q[1] + 1).min(dims[1] - 1) {
+                        for cx in q[0].saturating_sub(1)..=(q[0] + 1).min(dims[0] - 1) {
+                            let cell = (cz * dims[1] + cy) * dims[0] + cx;
+                            for &j in &order[head[cell] as usize..head[cell + 1] as usize] {
+                                let j = j as usize;
+                                let cut = bound[i] + bound[j] + skin;
+                                if j != i && (c[i] - c[j]).norm_squared() < cut * cut {
+                                    others.push(j);
+                                }
+                            }
+                        }
+                    }
+                }
+                others.sort_unstable();
+                // world bounds of the clusters of grain b (empty ones: radius < 0)
+                let clusters = |b: usize| -> [(Vector3<f64>, f64); CLUSTERS] {
+                    let mut out = [(Vector3::zeros(), -1.0); CLUSTERS];
+                    for (k, o) in out.iter_mut().enumerate() {
+                        let (cc, rr) = proxy.bounds[b * CLUSTERS + k];
+                        if rr >= 0.0 {
+                            *o = (c[b] + rot[b] * (lam * cc), lam * rr + eps[b]);
+                        }
+                    }
+                    out
+                };
+                let ci = clusters(i);
+                let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(mine.len() * 8);
+                for &j in &others {
+                    let cj = clusters(j);
+                    for (a, (pa, ra)) in ci.iter().enumerate() {
+                        if *ra < 0.0 {
+                            continue;
+                        }
+                        for (b, (pb, rb)) in cj.iter().enumerate() {
+                            let cut = ra + rb + skin;
+                            if *rb < 0.0 || (pa - pb).norm_squared() >= cut * cut {
+                                continue;
+                            }
+                            let ga = proxy.groups[i * CLUSTERS + a]..proxy.groups[i * CLUSTERS + a + 1];
+                            let gb = proxy.groups[j * CLUSTERS + b]..proxy.groups[j * CLUSTERS + b + 1];
+                            for s in ga {
+                                for t in gb.clone() {
+                                    let d = [x[s][0] - x[t][0], x[s][1] - x[t][1], x[s][2] - x[t][2]];
+                                    let cut = x[s][3] + x[t][3] + skin;
+                                    if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut {
+                                        pairs.push((s as u32, t as u32));
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                pairs.sort_unstable();
+                let mut lens = vec![0u32; mine.len()];
+                for &(s, _) in &pairs {
+                    lens[s as usize - mine.start] += 1;
+                }
+                let flat: Vec<u32> = pairs.into_iter().map(|(_, t)| t).collect();
+                (flat, lens)
+            })
+            .collect();
+        self.start.clear();
+        self.list.clear();
+        self.start.push(0);
+        for (flat, lens) in &lists {
+            self.list.extend_from_slice(flat);
+            for &l in lens {
+                let last = *self.start.last().unwrap_or(&0);
+                self.start.push(last + l);
+            }
+        }
+        self.x_build.clone_from(&self.x);
+        let container = self.container;
+        self.walled = self
+            .x
+            .par_iter()
+            .with_min_len(1024)
+            .map(|p| container.clearance(&Point3::new(p[0], p[1], p[2])) < p[3] + skin)
+            .collect();
+        self.built = true;
+    }
+
+    /// Sphere forces into `self.f`; the largest overlap (pairs and walls).
+    fn sphere_forces(&mut self) -> f64 {
+        let (x, start, list, container) = (&self.x, &self.start, &self.list, self.container);
+        let walled = &self.walled;
+        self.f
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(ch, fs)| {
+                let mut worst = f64::NEG_INFINITY;
+                for (o, f) in fs.iter_mut().enumerate() {
+                    let i = ch * CHUNK + o;
+                    let a = &x[i];
+                    let mut acc = [0.0; 3];
+                    for &j in &list[start[i] as usize..start[i + 1] as usize] {
+                        let b = &x[j as usize];
+                        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                        let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                        let cut = a[3] + b[3];
+                        if dd >= cut * cut {
+                            continue;
+                        }
+                        let dist = dd.sqrt().max(1e-300);
+                        let ov = cut - dist;
+                        worst = worst.max(ov);
+                        let k = ov / dist;
+                        for c in 0..3 {
+                            acc[c] += k * d[c];
+                        }
+                    }
+                    if walled[i] {
+                        let p = Point3::new(a[0], a[1], a[2]);
+                        let cl = container.clearance(&p);
+                        if cl < a[3] {
+                            let ov = a[3] - cl;
+                            worst = worst.max(ov);
+                            let h = 1e-4 * a[3];
+                            let mut g = [0.0; 3];
+                            for k in 0..3 {
+                                let mut e = p;
+                                let mut w = p;
+                                e[k] += h;
+                                w[k] -= h;
+                                g[k] = (container.clearance(&e) - container.clearance(&w)) / (2.0 * h);
+                            }
+                            let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+                            if len > 0.0 {
+                                for c in 0..3 {
+                                    acc[c] += ov * g[c] / len;
+                                }
+                            }
+                        }
+                    }
+                    *f = acc;
+                }
+                worst
+            })
+            .collect::<Vec<f64>>()
+            .into_iter()
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Body forces `(F, τ/k)` and the FIRE sums.
+    fn body_forces(&self) -> (Vec<[f64; 6]>, Sums) {
+        let n = self.c.len();
+        let (proxy, x, f, c, k, u) = (self.proxy, &self.x, &self.f, &self.c, &self.k, &self.u);
+        let g: Vec<[f64; 6]> = (0..n)
+            .into_par_iter()
+            .with_min_len(64)
+            .map(|b| {
+                let mut fo = Vector3::zeros();
+                let mut to = Vector3::zeros();
+                for s in proxy.start[b]..proxy.start[b + 1] {
+                    let fs = Vector3::new(f[s][0], f[s][1], f[s][2]);
+                    let arm = Vector3::new(x[s][0], x[s][1], x[s][2]) - c[b];
+                    fo += fs;
+                    to += arm.cross(&fs);
+                }
+                let t = to / k[b];
+                [fo.x, fo.y, fo.z, t.x, t.y, t.z]
+            })
+            .collect();
+        let sums = g
+            .par_chunks(CHUNK)
+            .zip(u.par_chunks(CHUNK))
+            .map(|(gs, us)| {
+                let mut s = Sums::default();
+                for (gi, ui) in gs.iter().zip(us) {
+                    for d in 0..6 {
+                        s.power += gi[d] * ui[d];
+                        s.ff += gi[d] * gi[d];
+                        s.uu += ui[d] * ui[d];
+                    }
+                }
+                s
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .fold(Sums::default(), |a, b| Sums {
+                power: a.power + b.power,
+                ff: a.ff + b.ff,
+                uu: a.uu + b.uu,
+            });
+        (g, sums)
+    }
+
+    /// FIRE until the largest overlap is at most the tolerance (`true`) or
+    /// `max_iter` iterations (`false`).
+    fn relax(&mut self, max_iter: usize, stats: &mut CompactStats) -> bool {
+        const N_MIN: usize = 5;
+        const F_INC: f64 = 1.1;
+        const F_DEC: f64 = 0.5;
+        const ALPHA0: f64 = 0.1;
+        const F_ALPHA: f64 = 0.99;
+        const DT0: f64 = 0.05;
+        const DT_MAX: f64 = 0.25;
+        let mut dt = DT0;
+        let mut alpha = ALPHA0;
+        let mut npos = 0usize;
+        self.u.iter_mut().for_each(|u| *u = [0.0; 6]);
+        let lim = 0.25 * self.skin * self.skin;
+        for it in 0..=max_iter {
+            let stale = self.built && {
+                self.place();
+                let (x, xb) = (&self.x, &self.x_build);
+                x.par_chunks(CHUNK)
+                    .zip(xb.par_chunks(CHUNK))
+                    .any(|(a, b)| {
+                        a.iter().zip(b).any(|(p, q)| {
+                            (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)
+                                > lim
+                        })
+                    })
+            };
+            if stale || !self.built {
+                self.build();
+                stats.neighbour_builds += 1;
+            }
+            let worst = self.sphere_forces();
+            if worst <= self.tol {
+                return true;
+            }
+            if it == max_iter {
+                break;
+            }
+            stats.iterations += 1;
+            let (g, s) = self.body_forces();
+            let mix = if s.power > 0.0 {
+                npos += 1;
+                if npos > N_MIN {
+                    dt = (dt * F_INC).min(DT_MAX);
+                    alpha *= F_ALPHA;
+                }
+                Some(if s.ff > 0.0 {
+                    alpha * (s.uu / s.ff).sqrt()
+                } else {
+                    0.0
+                })
+            } else {
+                npos = 0;
+                dt *= F_DEC;
+                alpha = ALPHA0;
+                None
+            };
+            let a = alpha;
+            (
+                self.u.par_iter_mut(),
+                self.c.par_iter_mut(),
+                self.q.par_iter_mut(),
+                self.rot.par_iter_mut(),
+            )
+                .into_par_iter()
+                .zip(g.par_iter())
+                .zip(self.k.par_iter())
+                .with_min_len(64)
+                .for_each(|(((u, c, q, r), gi), k)| {
+                    for d in 0..6 {
+                        u[d] = match mix {
+                            Some(m) => (1.0 - a) * u[d] + m * gi[d],
+                            None => 0.0,
+                        } + dt * gi[d];
+                    }
+                    *c += dt * Vector3::new(u[0], u[1], u[2]);
+                    let w = (dt / k) * Vector3::new(u[3], u[4], u[5]);
+                    if w != Vector3::zeros() {
+                        *q = UnitQuaternion::from_scaled_axis(w) * *q;
+                        *r = q.to_rotation_matrix().into_inner();
+                    }
+                });
+        }
+        false
+    }
+
+    /// Largest overlap of the current state (neighbour list rebuilt).
+    fn worst(&mut self) -> f64 {
+        self.build();
+        self.sphere_forces()
+    }
+}
+
+/// Grows the grains' proxies from scale `lam0` to 1 inside `container`,
+/// moving `centres` and `quats` (FIRE on rigid clumps: see the parent
+/// module).
+///
+/// # Errors
+/// [`Error::NotConverged`] when a growth step of 1e-3 does not relax
+/// (naming the scale reached).
+pub(super) fn compact(
+    grains: &[StarGrain],
+    proxy: &Proxy,
+    container: &Container,
+    centres: &mut [Vector3<f64>],
+    quats: &mut [UnitQuaternion<f64>],
+    lam0: f64,
+    params: &CompactParams,
+) -> Result<CompactStats> {
+    let n = grains.len();
+    let d_eq: Vec<f64> = grains.iter().map(StarGrain::equivalent_diameter).collect();
+    let d_min = d_eq.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut sorted = d_eq.clone();
+    sorted.sort_by(f64::total_cmp);
+    let d_med = sorted[n / 2];
+    let mut body = vec![0u32; proxy.len()];
+    for i in 0..n {
+        for s in proxy.start[i]..proxy.start[i + 1] {
+            body[s] = i as u32;
+        }
+    }
+    let mut sys = System {
+        proxy,
+        container,
+        body,
+        c: centres.to_vec(),
+        q: quats.to_vec(),
+        rot: quats
+            .iter()
+            .map(|q| q.to_rotation_matrix().into_inner())
+            .collect(),
+        u: vec![[0.0; 6]; n],
+        k: d_eq.iter().map(|d| (0.1f64).sqrt() * d).collect(),
+        eps: d_eq.iter().map(|d| params.inflate * d).collect(),
+        lam: lam0,
+        x: vec![[0.0; 4]; proxy.len()],
+        f: vec![[0.0; 3]; proxy.len()],
+        start: Vec::new(),
+        list: Vec::new(),
+        x_build: Vec::new(),
+        walled: Vec::new(),
+        skin: 0.1 * d_med,
+        tol: params.tolerance * d_min,
+        built: false,
+    };
+    let mut stats = CompactStats {
+        spheres: proxy.len(),
+        ..CompactStats::default()
+    };
+    let mut lam = lam0.min(1.0);
+    sys.lam = lam;
+    if !sys.relax(params.max_iterations, &mut stats) {
+        return Err(not_converged(&mut sys, &stats, lam));
+    }
+    let mut saved = (sys.c.clone(), sys.q.clone());
+    let mut step = MAX_GROWTH;
+    while lam < 1.0 {
+        let next = (lam + step).min(1.0);
+        sys.lam = next;
+        sys.built = false;
+        if sys.relax(params.max_iterations, &mut stats) {
+            stats.steps_accepted += 1;
+            lam = next;
+            saved = (sys.c.clone(), sys.q.clone());
+            step = (step * 1.5).min(MAX_GROWTH);
+        } else {
+            stats.steps_rejected += 1;
+            if step * 0.5 < MIN_GROWTH {
+                // the overlaps left at the failed scale, then the clean state
+                return Err(not_converged(&mut sys, &stats, lam));
+            }
+            sys.c.clone_from(&saved.0);
+            sys.q.clone_from(&saved.1);
+            sys.rot = sys
+                .q
+                .iter()
+                .map(|q| q.to_rotation_matrix().into_inner())
+                .collect();
+            sys.lam = lam;
+            sys.built = false;
+            step *= 0.5;
+        }
+    }
+    centres.copy_from_slice(&sys.c);
+    quats.copy_from_slice(&sys.q);
+    Ok(stats)
+}
+
+fn not_converged(sys: &mut System<'_>, stats: &CompactStats, lam: f64) -> Error {
+    let _ = sys.worst();
+    let x = &sys.x;
+    let mut pairs = std::collections::BTreeSet::new();
+    for i in 0..x.len() {
+        for &j in &sys.list[sys.start[i] as usize..sys.start[i + 1] as usize] {
+            let b = &x[j as usize];
+            let d = ((x[i][0] - b[0]).powi(2) + (x[i][1] - b[1]).powi(2) + (x[i][2] - b[2]).powi(2))
+                .sqrt();
+            if x[i][3] + b[3] - d > sys.tol {
+                let (p, q) = (sys.body[i], sys.body[j as usize]);
+                pairs.insert((p.min(q), p.max(q)));
+            }
+        }
+    }
+    Error::NotConverged {
+        sweeps: stats.iterations,
+        overlapping_pairs: pairs.len(),
+        scale: lam,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn proxies_cover_spheres_and_ellipsoids() {
+        let dirs = fibonacci(200);
+        for g in [
+            StarGrain::sphere(1.0).unwrap(),
+            StarGrain::ellipsoid(1.2, 1.0, 0.8, 12).unwrap(),
+            StarGrain::ellipsoid(2.0, 1.0, 0.5, 12).unwrap(),
+        ] {
+            let p = build(std::slice::from_ref(&g), 24);
+            let cov = p.coverage(0, &g, &dirs);
+            let surf = surface(&g, 16);
+            let def: Vec<f64> = surf
+                .iter()
+                .map(|x| {
+                    (0..p.len())
+                        .map(|s| (x - p.off[s]).norm() - p.rad[s])
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect();
+            let r_eq = 0.5 * g.equivalent_diameter();
+            eprintln!(
+                "spheres {} coverage {cov:.4} deficit/r_eq max {:.4} mean {:.4}",
+                p.len(),
+                def.iter().fold(0.0f64, |a, &b| a.max(b)) / r_eq,
+                def.iter().sum::<f64>() / def.len() as f64 / r_eq
+            );
+            assert!(cov > 0.9, "{cov}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod debug_tests {
+    use super::super::*;
+    use super::*;
+
+    #[test]
+    fn compaction_leaves_true_surfaces_apart() {
+        let txt = std::fs::read_to_string("/tmp/exp/ottawa2k.txt").unwrap();
+        let grains: Vec<StarGrain> = txt.lines().take(400).map(|l| {
+            let r: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            StarGrain::from_table(16, &r).unwrap()
+        }).collect();
+        {
+            let dirs = fibonacci(200);
+            let p = build(&grains[..20], 48);
+            for i in 0..20 {
+                let g = &grains[i];
+                let surf = surface(g, 16);
+                let (a, b) = (p.start[i], p.start[i + 1]);
+                let def = surf.iter().map(|x| (a..b).map(|s| (x - p.off[s]).norm() - p.rad[s]).fold(f64::INFINITY, f64::min)).fold(0.0f64, f64::max);
+                eprintln!("grain {i}: {} spheres, coverage {:.3}, max deficit / r_eq {:.3}, r_max/r_eq {:.3}", b - a, p.coverage(i, g, &dirs), def / (0.5 * g.equivalent_diameter()), g.r_max() / (0.5 * g.equivalent_diameter()));
+            }
+        }
+        let cont = container_for(&Container::triaxial(1.0), &grains, 0.55).unwrap();
+        let params = GrainPackParams::default();
+        let (mut centres, scale, _) = skeleton(&grains, &cont, &params).unwrap();
+        let mut q: Vec<UnitQuaternion<f64>> = (0..400)
+            .map(|i| random_rotation(&mut stream(1, i as u64)))
+            .collect();
+        let beta = params.skeleton_blend;
+        let lam0 = grains
+            .iter()
+            .map(|g| 0.5 * scale * ((1.0 - beta) * g.equivalent_diameter() + beta * 2.0 * g.r_max()) / g.r_max())
+            .fold(1.0_f64, f64::min);
+        let proxy = build(&grains, 48);
+        let st = compact(&grains, &proxy, &cont, &mut centres, &mut q, lam0, &CompactParams { inflate: 0.015, tolerance: 1e-3, max_iterations: 5000 }).unwrap();
+        eprintln!("lam0 {lam0} {st:?}");
+        // exact: fine surface nodes of i inside j
+        let mut worst = f64::INFINITY;
+        let mut bad = 0;
+        for i in 0..400 {
+            let si = surface(&grains[i], 16);
+            for j in 0..400 {
+                if i == j || (centres[i] - centres[j]).norm() > grains[i].r_max() + grains[j].r_max() {
+                    continue;
+                }
+                let rj = q[j].to_rotation_matrix().into_inner();
+                let ri = q[i].to_rotation_matrix().into_inner();
+                let mut w = f64::INFINITY;
+                for s in &si {
+                    let x = ri * s + centres[i];
+                    let b = rj.transpose() * (x - centres[j]);
+                    w = w.min(b.norm() - grains[j].radius(&b));
+                }
+                if w < 0.0 { bad += 1; }
+                worst = worst.min(w / grains[j].equivalent_diameter());
+            }
+        }
+        eprintln!("worst radial gap / d {worst:.4}, {bad} overlapping ordered pairs");
+    }
+}
