@@ -10,7 +10,8 @@ use clap::Args;
 /// Flags of `cargo xtask validate`.
 #[derive(Debug, Args)]
 pub(crate) struct Validate {
-    /// Run only the cases whose name contains this pattern.
+    /// Run only the cases whose name contains this pattern (or one of
+    /// several, comma-separated).
     #[arg(long)]
     filter: Option<String>,
     /// Write `validate.md` and `validate.csv` into this directory.

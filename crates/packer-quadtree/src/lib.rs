@@ -104,7 +104,7 @@ pub use ga::{GaParams, GaResult, graded_layers, optimise_porosity};
 pub use grading::{Grading, MixtureComponent, estimate_count};
 pub use grains3d::{
     CheckParams, Fabric, GrainOverlapReport, GrainPackParams, GrainPackStats, GrainPacking,
-    StarGrain, check_grain_overlaps, container_for, orientation_fabric, pack_grains,
+    StarGrain, check_grain_overlaps, container_for, occupied, orientation_fabric, pack_grains,
     random_rotation,
 };
 pub use index::{CellGrid, MxQuadtree, SpatialIndex};

@@ -130,7 +130,8 @@ pub struct Row {
 /// What to run.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
-    /// Only cases whose name contains this substring.
+    /// Only cases whose name contains this substring (or one of several,
+    /// comma-separated).
     pub filter: Option<String>,
     /// Only the fast subset.
     pub fast_only: bool,
@@ -155,7 +156,7 @@ pub fn run(cases: &[Case], expected: &[ExpectedFailure], options: &RunOptions) -
             continue;
         }
         if let Some(filter) = &options.filter
-            && !case.name.contains(filter.as_str())
+            && !filter.split(',').any(|f| case.name.contains(f))
         {
             continue;
         }

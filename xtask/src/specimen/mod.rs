@@ -371,6 +371,16 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             } => (None, Some((*solid_fraction, *lower_if_needed))),
             other => (Some(fixed_container(other)), None),
         };
+        // refuse a narrow container before spending the packing on it
+        let planned = match &fixed {
+            Some(c) => c.clone(),
+            None => packer_quadtree::container_for(
+                &Container::triaxial(1.0),
+                grains,
+                auto.map_or(0.5, |a| a.0),
+            )?,
+        };
+        refuse_narrow(scene, &planned, &[], grain_d_max(grains))?;
         let pb = crate::progress::spinner("packing grains", quiet);
         let gp = place::place_grains(grains, fixed, auto, scene.preset, seed)?;
         pb.finish_and_clear();
@@ -379,7 +389,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
             "place",
             t,
             format!(
-                "{} grains (star tables, {STAR_FACE_CELLS} cells per cube face) packed in {}{} by pack_grains ({:?} skeleton): solid fraction {:.4}, {} + {} sweeps, worst gap / d {:.2e}",
+                "{} grains (star tables, {STAR_FACE_CELLS} cells per cube face) packed in {}{} by pack_grains ({:?} skeleton): solid fraction {:.4}; compaction: {} proxy spheres, {} growth steps ({} undone), {} FIRE iterations, {} neighbour builds; first gap sweep: {} overlapping pairs, deepest / d {:.2e}; {} + {} sweeps, worst gap / d {:.2e}",
                 grains.len(),
                 describe(&gp.container),
                 if gp.tries > 1 {
@@ -394,6 +404,13 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 },
                 scene.preset,
                 s.solid_fraction,
+                s.compaction.spheres,
+                s.compaction.steps_accepted,
+                s.compaction.steps_rejected,
+                s.compaction.iterations,
+                s.compaction.neighbour_builds,
+                s.initial_overlaps,
+                s.initial_depth_over_d,
                 s.coarse_sweeps,
                 s.fine_sweeps,
                 s.worst_gap_over_d,
@@ -423,27 +440,13 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
 
     // the walls' share of the specimen (issue 28): refuse a narrow container unless asked
     let d_max = match &grains {
-        Some(g) => g
-            .iter()
-            .map(|g| (6.0 * g.volume() / std::f64::consts::PI).cbrt())
-            .fold(0.0, f64::max),
+        Some(g) => grain_d_max(g),
         None => to_place
             .iter()
             .map(|c| 2.0 * c.bounding_radius)
             .fold(0.0, f64::max),
     };
-    let wall = place::wall_share(&container, &poses, d_max);
-    if wall.width < 8.0 * d_max && !scene.allow_narrow_container {
-        bail!(
-            "the container is {:.2} d_max wide (width {:.4}, d_max {:.4}), narrower than 8 d_max: \
-             the walls dominate such a packing ({:.1} % of the grains lie within one d_max of a \
-             wall); use a wider container, or set `allow_narrow_container: true` to accept it",
-            wall.width / d_max,
-            wall.width,
-            d_max,
-            100.0 * wall.near_fraction
-        );
-    }
+    let wall = refuse_narrow(scene, &container, &poses, d_max)?;
     st.note(
         "place",
         format!(
@@ -1288,4 +1291,43 @@ fn fixed_container(spec: &ContainerSpec) -> Container {
         // sized by the caller
         ContainerSpec::AutoCylinder { .. } => Container::triaxial(1.0),
     }
+}
+
+/// The largest volume-equivalent diameter of the grains.
+fn grain_d_max(grains: &[StarGrain]) -> f64 {
+    grains
+        .iter()
+        .map(|g| (6.0 * g.volume() / std::f64::consts::PI).cbrt())
+        .fold(0.0, f64::max)
+}
+
+/// The walls' share of the specimen (issue 28): refuses a container
+/// narrower than 8 d_max unless the scene allows it (periodic sides are not
+/// walls: an x–y periodic box is never narrow).
+fn refuse_narrow(
+    scene: &Scene,
+    container: &Container,
+    poses: &[nalgebra::Isometry3<f64>],
+    d_max: f64,
+) -> anyhow::Result<place::WallShare> {
+    let wall = place::wall_share(container, poses, d_max);
+    if wall.width < 8.0 * d_max && !scene.allow_narrow_container {
+        bail!(
+            "the container is {:.2} d_max wide (width {:.4}, d_max {:.4}), narrower than 8 d_max: \
+             the walls dominate such a packing{}; use a wider container, or set \
+             `allow_narrow_container: true` to accept it",
+            wall.width / d_max,
+            wall.width,
+            d_max,
+            if poses.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " ({:.1} % of the grains lie within one d_max of a wall)",
+                    100.0 * wall.near_fraction
+                )
+            }
+        );
+    }
+    Ok(wall)
 }

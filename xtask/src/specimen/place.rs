@@ -197,7 +197,9 @@ pub(crate) fn place_grains(
     let too_dense = |e: &packer_quadtree::Error| {
         matches!(
             e,
-            packer_quadtree::Error::NotConverged { .. } | packer_quadtree::Error::TooDense { .. }
+            packer_quadtree::Error::NotConverged { .. }
+                | packer_quadtree::Error::TooDense { .. }
+                | packer_quadtree::Error::FractionNotReached { .. }
         )
     };
     if let Some(c) = container {
@@ -253,6 +255,9 @@ pub(crate) fn place_grains(
                                 fraction * scale.powi(3)
                             )
                         }
+                        packer_quadtree::Error::FractionNotReached { reached, .. } => format!(
+                            "at solid fraction {fraction:.4} the compaction jammed: the grains were separated up to solid fraction {reached:.4} ({e})"
+                        ),
                         packer_quadtree::Error::NotConverged { .. } => format!(
                             "at solid fraction {fraction:.4} the grains grew to full size but no overlap-free packing was found ({e})"
                         ),
@@ -294,7 +299,16 @@ pub(crate) struct WallShare {
 pub(crate) fn wall_share(c: &Container, poses: &[Isometry3<f64>], d_max: f64) -> WallShare {
     let width = match c {
         Container::Cylinder { radius, .. } => 2.0 * radius,
-        Container::Box { min, max, .. } => (max.x - min.x).min(max.y - min.y),
+        Container::Box { min, max, periodic } => {
+            let side = |k: usize| {
+                if periodic[k] {
+                    f64::INFINITY
+                } else {
+                    max[k] - min[k]
+                }
+            };
+            side(0).min(side(1))
+        }
         _ => c.inscribed_diameter(),
     };
     let near = poses

@@ -1,7 +1,7 @@
 //! Compaction of a grain skeleton by FIRE on sphere proxies: each grain is
 //! a rigid clump of spheres inscribed in its star surface, the clumps grow
 //! from the skeleton's scale to full size while FIRE removes the overlaps of
-//! spheres of different grains (see the parent module, step 3a).
+//! spheres of different grains (see the parent module, step 3).
 
 use nalgebra::{Matrix3, Point3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
@@ -93,7 +93,11 @@ impl Proxy {
 /// Surface points `r(u)·u` of `g` at the cube-map vertices of `face_cells`.
 fn surface(g: &StarGrain, face_cells: usize) -> Vec<Vector3<f64>> {
     levelset::cube_map_directions(face_cells)
-        .map(|d| d.into_iter().map(|u| u.into_inner() * g.radius(&u)).collect())
+        .map(|d| {
+            d.into_iter()
+                .map(|u| u.into_inner() * g.radius(&u))
+                .collect()
+        })
         .unwrap_or_default()
 }
 
@@ -240,6 +244,9 @@ pub(super) struct CompactParams {
     pub tolerance: f64,
     /// FIRE iterations per growth step.
     pub max_iterations: usize,
+    /// Whether the grains may turn (off: translations only, orientations
+    /// kept as given).
+    pub rotations: bool,
 }
 
 /// Counters of a compaction.
@@ -292,6 +299,8 @@ struct System<'a> {
     skin: f64,
     tol: f64,
     built: bool,
+    /// Torques applied (off: translations only).
+    rotations: bool,
 }
 
 impl System<'_> {
@@ -420,11 +429,14 @@ impl System<'_> {
                             if *rb < 0.0 || (pa - pb).norm_squared() >= cut * cut {
                                 continue;
                             }
-                            let ga = proxy.groups[i * CLUSTERS + a]..proxy.groups[i * CLUSTERS + a + 1];
-                            let gb = proxy.groups[j * CLUSTERS + b]..proxy.groups[j * CLUSTERS + b + 1];
+                            let ga =
+                                proxy.groups[i * CLUSTERS + a]..proxy.groups[i * CLUSTERS + a + 1];
+                            let gb =
+                                proxy.groups[j * CLUSTERS + b]..proxy.groups[j * CLUSTERS + b + 1];
                             for s in ga {
                                 for t in gb.clone() {
-                                    let d = [x[s][0] - x[t][0], x[s][1] - x[t][1], x[s][2] - x[t][2]];
+                                    let d =
+                                        [x[s][0] - x[t][0], x[s][1] - x[t][1], x[s][2] - x[t][2]];
                                     let cut = x[s][3] + x[t][3] + skin;
                                     if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut {
                                         pairs.push((s as u32, t as u32));
@@ -506,7 +518,8 @@ impl System<'_> {
                                 let mut w = p;
                                 e[k] += h;
                                 w[k] -= h;
-                                g[k] = (container.clearance(&e) - container.clearance(&w)) / (2.0 * h);
+                                g[k] =
+                                    (container.clearance(&e) - container.clearance(&w)) / (2.0 * h);
                             }
                             let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
                             if len > 0.0 {
@@ -541,7 +554,11 @@ impl System<'_> {
                     fo += fs;
                     to += arm.cross(&fs);
                 }
-                let t = to / k[b];
+                let t = if self.rotations {
+                    to / k[b]
+                } else {
+                    Vector3::zeros()
+                };
                 [fo.x, fo.y, fo.z, t.x, t.y, t.z]
             })
             .collect();
@@ -588,14 +605,11 @@ impl System<'_> {
             let stale = self.built && {
                 self.place();
                 let (x, xb) = (&self.x, &self.x_build);
-                x.par_chunks(CHUNK)
-                    .zip(xb.par_chunks(CHUNK))
-                    .any(|(a, b)| {
-                        a.iter().zip(b).any(|(p, q)| {
-                            (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)
-                                > lim
-                        })
+                x.par_chunks(CHUNK).zip(xb.par_chunks(CHUNK)).any(|(a, b)| {
+                    a.iter().zip(b).any(|(p, q)| {
+                        (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2) > lim
                     })
+                })
             };
             if stale || !self.built {
                 self.build();
@@ -687,9 +701,7 @@ pub(super) fn compact(
     let d_med = sorted[n / 2];
     let mut body = vec![0u32; proxy.len()];
     for i in 0..n {
-        for s in proxy.start[i]..proxy.start[i + 1] {
-            body[s] = i as u32;
-        }
+        body[proxy.start[i]..proxy.start[i + 1]].fill(i as u32);
     }
     let mut sys = System {
         proxy,
@@ -714,6 +726,7 @@ pub(super) fn compact(
         skin: 0.1 * d_med,
         tol: params.tolerance * d_min,
         built: false,
+        rotations: params.rotations,
     };
     let mut stats = CompactStats {
         spheres: proxy.len(),
@@ -765,8 +778,9 @@ fn not_converged(sys: &mut System<'_>, stats: &CompactStats, lam: f64) -> Error 
     for i in 0..x.len() {
         for &j in &sys.list[sys.start[i] as usize..sys.start[i + 1] as usize] {
             let b = &x[j as usize];
-            let d = ((x[i][0] - b[0]).powi(2) + (x[i][1] - b[1]).powi(2) + (x[i][2] - b[2]).powi(2))
-                .sqrt();
+            let d =
+                ((x[i][0] - b[0]).powi(2) + (x[i][1] - b[1]).powi(2) + (x[i][2] - b[2]).powi(2))
+                    .sqrt();
             if x[i][3] + b[3] - d > sys.tol {
                 let (p, q) = (sys.body[i], sys.body[j as usize]);
                 pairs.insert((p.min(q), p.max(q)));
@@ -784,95 +798,177 @@ fn not_converged(sys: &mut System<'_>, stats: &CompactStats, lam: f64) -> Error 
 mod tests {
     use super::*;
 
+    /// Coverage, surface deficit and protrusion of the proxies of a sphere
+    /// and ellipsoids: a sphere is its own proxy; a mild ellipsoid is
+    /// covered to the deficit criterion; an elongated flat one (2:1:0.5)
+    /// gains coverage with the sphere budget; no proxy sphere stands out of
+    /// the surface by more than the allowed protrusion.
     #[test]
     fn proxies_cover_spheres_and_ellipsoids() {
         let dirs = fibonacci(200);
-        for g in [
-            StarGrain::sphere(1.0).unwrap(),
-            StarGrain::ellipsoid(1.2, 1.0, 0.8, 12).unwrap(),
-            StarGrain::ellipsoid(2.0, 1.0, 0.5, 12).unwrap(),
-        ] {
-            let p = build(std::slice::from_ref(&g), 24);
-            let cov = p.coverage(0, &g, &dirs);
-            let surf = surface(&g, 16);
-            let def: Vec<f64> = surf
+        let measure = |g: &StarGrain, per_grain: usize| {
+            let p = build(std::slice::from_ref(g), per_grain);
+            let r_eq = 0.5 * g.equivalent_diameter();
+            let deficit = surface(g, 16)
                 .iter()
                 .map(|x| {
                     (0..p.len())
                         .map(|s| (x - p.off[s]).norm() - p.rad[s])
                         .fold(f64::INFINITY, f64::min)
                 })
-                .collect();
-            let r_eq = 0.5 * g.equivalent_diameter();
-            eprintln!(
-                "spheres {} coverage {cov:.4} deficit/r_eq max {:.4} mean {:.4}",
-                p.len(),
-                def.iter().fold(0.0f64, |a, &b| a.max(b)) / r_eq,
-                def.iter().sum::<f64>() / def.len() as f64 / r_eq
-            );
-            assert!(cov > 0.9, "{cov}");
-        }
+                .fold(0.0f64, f64::max)
+                / r_eq;
+            // protrusion: distance of the proxy's points outside the
+            // surface to the surface (its fine vertices)
+            let fine = surface(g, 32);
+            let mut protrusion = 0.0f64;
+            for s in 0..p.len() {
+                for u in &dirs {
+                    let x = p.off[s] + p.rad[s] * u;
+                    if x.norm() > g.radius(&x) {
+                        let d = fine
+                            .iter()
+                            .map(|y| (x - y).norm())
+                            .fold(f64::INFINITY, f64::min);
+                        protrusion = protrusion.max(d / r_eq);
+                    }
+                }
+            }
+            (p.len(), p.coverage(0, g, &dirs), deficit, protrusion)
+        };
+        let (n, cov, def, _) = measure(&StarGrain::sphere(1.0).expect("valid shape"), 48);
+        assert_eq!(n, 1);
+        assert!(cov > 0.999 && def < 1e-9, "{cov} {def}");
+        let mild = StarGrain::ellipsoid(1.2, 1.0, 0.8, 12).expect("valid shape");
+        let (n, cov, def, pro) = measure(&mild, 48);
+        assert!(
+            n < 48 && def <= 1.5 * DEFICIT && cov > 0.99,
+            "{n} {cov} {def}"
+        );
+        assert!(pro <= PROTRUDE + 0.01, "{pro}");
+        let long = StarGrain::ellipsoid(2.0, 1.0, 0.5, 12).expect("valid shape");
+        let (n24, cov24, _, pro24) = measure(&long, 24);
+        let (n48, cov48, _, pro48) = measure(&long, 48);
+        assert!(n24 <= 25 && n48 <= 49 && n48 > n24, "{n24} {n48}");
+        assert!(cov24 > 0.8 && cov48 > cov24, "{cov24} {cov48}");
+        // On flat faces the surface samples are sparse (cube-map directions
+        // at grazing incidence), so a sphere may stand out between them by
+        // up to about three times the allowed protrusion: the proxy is then
+        // a little conservative there (over-excludes), never unsafe.
+        assert!(pro24.max(pro48) <= 3.0 * PROTRUDE, "{pro24} {pro48}");
     }
 }
 
 #[cfg(test)]
-mod debug_tests {
+mod compaction_tests {
+    #![allow(clippy::needless_range_loop)] // pairs (i, j) index several arrays
+
     use super::super::*;
     use super::*;
 
+    /// Grows 150 ellipsoids of mixed sizes and aspects from the skeleton to
+    /// full size at solid fraction 0.55: the proxies end apart (within the
+    /// tolerance) and the true surfaces overlap at most by the proxies'
+    /// allowed protrusion, which the gap minimisation then removes.
     #[test]
-    fn compaction_leaves_true_surfaces_apart() {
-        let txt = std::fs::read_to_string("/tmp/exp/ottawa2k.txt").unwrap();
-        let grains: Vec<StarGrain> = txt.lines().take(400).map(|l| {
-            let r: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            StarGrain::from_table(16, &r).unwrap()
-        }).collect();
-        {
-            let dirs = fibonacci(200);
-            let p = build(&grains[..20], 48);
-            for i in 0..20 {
-                let g = &grains[i];
-                let surf = surface(g, 16);
-                let (a, b) = (p.start[i], p.start[i + 1]);
-                let def = surf.iter().map(|x| (a..b).map(|s| (x - p.off[s]).norm() - p.rad[s]).fold(f64::INFINITY, f64::min)).fold(0.0f64, f64::max);
-                eprintln!("grain {i}: {} spheres, coverage {:.3}, max deficit / r_eq {:.3}, r_max/r_eq {:.3}", b - a, p.coverage(i, g, &dirs), def / (0.5 * g.equivalent_diameter()), g.r_max() / (0.5 * g.equivalent_diameter()));
-            }
-        }
-        let cont = container_for(&Container::triaxial(1.0), &grains, 0.55).unwrap();
+    fn compaction_grows_grains_to_full_size_with_proxies_apart() {
+        let n = 150;
+        let grains: Vec<StarGrain> = (0..n)
+            .map(|i| {
+                let s = 1.0 + (i % 7) as f64 / 6.0;
+                let (a, c) = [(1.3, 0.8), (1.1, 0.9), (1.5, 0.7)][i % 3];
+                StarGrain::ellipsoid(a * s, s, c * s, 12).expect("valid shape")
+            })
+            .collect();
+        let cont = container_for(&Container::triaxial(1.0), &grains, 0.55).expect("container");
         let params = GrainPackParams::default();
-        let (mut centres, scale, _) = skeleton(&grains, &cont, &params).unwrap();
-        let mut q: Vec<UnitQuaternion<f64>> = (0..400)
+        let (mut centres, scale, _) = skeleton(&grains, &cont, &params).expect("skeleton");
+        let mut q: Vec<UnitQuaternion<f64>> = (0..n)
             .map(|i| random_rotation(&mut stream(1, i as u64)))
             .collect();
         let beta = params.skeleton_blend;
         let lam0 = grains
             .iter()
-            .map(|g| 0.5 * scale * ((1.0 - beta) * g.equivalent_diameter() + beta * 2.0 * g.r_max()) / g.r_max())
+            .map(|g| {
+                0.5 * scale * ((1.0 - beta) * g.equivalent_diameter() + beta * 2.0 * g.r_max())
+                    / g.r_max()
+            })
             .fold(1.0_f64, f64::min);
+        assert!(lam0 < 0.9, "the skeleton starts small: {lam0}");
         let proxy = build(&grains, 48);
-        let st = compact(&grains, &proxy, &cont, &mut centres, &mut q, lam0, &CompactParams { inflate: 0.015, tolerance: 1e-3, max_iterations: 5000 }).unwrap();
-        eprintln!("lam0 {lam0} {st:?}");
-        // exact: fine surface nodes of i inside j
-        let mut worst = f64::INFINITY;
-        let mut bad = 0;
-        for i in 0..400 {
-            let si = surface(&grains[i], 16);
-            for j in 0..400 {
-                if i == j || (centres[i] - centres[j]).norm() > grains[i].r_max() + grains[j].r_max() {
+        let tolerance = 1e-3;
+        let st = compact(
+            &grains,
+            &proxy,
+            &cont,
+            &mut centres,
+            &mut q,
+            lam0,
+            &CompactParams {
+                inflate: 0.015,
+                tolerance,
+                max_iterations: 5000,
+                rotations: true,
+            },
+        )
+        .expect("compaction");
+        assert!(st.steps_accepted >= 1 && st.iterations > 0, "{st:?}");
+        // proxies apart: sphere pairs of different grains
+        let rot: Vec<Matrix3<f64>> = q
+            .iter()
+            .map(|r| r.to_rotation_matrix().into_inner())
+            .collect();
+        let d_min = grains
+            .iter()
+            .map(|g| g.equivalent_diameter())
+            .fold(f64::INFINITY, f64::min);
+        let mut worst_proxy = f64::INFINITY;
+        for i in 0..n {
+            for j in i + 1..n {
+                if (centres[i] - centres[j]).norm() > grains[i].r_max() + grains[j].r_max() {
                     continue;
                 }
-                let rj = q[j].to_rotation_matrix().into_inner();
-                let ri = q[i].to_rotation_matrix().into_inner();
-                let mut w = f64::INFINITY;
-                for s in &si {
-                    let x = ri * s + centres[i];
-                    let b = rj.transpose() * (x - centres[j]);
-                    w = w.min(b.norm() - grains[j].radius(&b));
+                for a in proxy.start[i]..proxy.start[i + 1] {
+                    let xa = centres[i] + rot[i] * proxy.off[a];
+                    for b in proxy.start[j]..proxy.start[j + 1] {
+                        let xb = centres[j] + rot[j] * proxy.off[b];
+                        let gap = (xa - xb).norm() - proxy.rad[a] - proxy.rad[b];
+                        worst_proxy = worst_proxy.min(gap / d_min);
+                    }
                 }
-                if w < 0.0 { bad += 1; }
-                worst = worst.min(w / grains[j].equivalent_diameter());
             }
         }
-        eprintln!("worst radial gap / d {worst:.4}, {bad} overlapping ordered pairs");
+        assert!(
+            worst_proxy > -2.0 * tolerance,
+            "proxy overlap / d_min {worst_proxy}"
+        );
+        // true surfaces: surface nodes of i inside j, radially
+        let mut worst = f64::INFINITY;
+        for i in 0..n {
+            let si = surface(&grains[i], 16);
+            for j in 0..n {
+                if i == j
+                    || (centres[i] - centres[j]).norm() > grains[i].r_max() + grains[j].r_max()
+                {
+                    continue;
+                }
+                for s in &si {
+                    let x = rot[i] * s + centres[i];
+                    let b = rot[j].transpose() * (x - centres[j]);
+                    let w = b.norm() - grains[j].radius(&b);
+                    worst = worst.min(w / grains[j].equivalent_diameter());
+                }
+            }
+        }
+        assert!(worst > -PROTRUDE, "true overlap / d {worst}");
+        // inside the container
+        for i in 0..n {
+            for s in surface(&grains[i], 8) {
+                let x = rot[i] * s + centres[i];
+                assert!(
+                    cont.clearance(&Point3::from(x)) > -PROTRUDE * grains[i].equivalent_diameter()
+                );
+            }
+        }
     }
 }
