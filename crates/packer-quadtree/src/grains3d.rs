@@ -41,7 +41,9 @@
 //!    surface by 0.04 r_eq where sparse samples allow, up to ~0.11 r_eq on
 //!    flat faces). The clumps, each sphere inflated by 0.015 d_eq, start at
 //!    the skeleton's scale `λ₀` and grow to full size in steps of up to
-//!    0.15 (halved when a step does not relax, down to 2e-3); after every
+//!    0.15 (halved when a step does not relax — within 5000 iterations,
+//!    or when its deepest overlap shrinks by less than a tenth over 500 —
+//!    down to 2e-3); after every
 //!    step FIRE (Bitzek et al. 2006) minimises the harmonic overlap energy
 //!    of spheres of different grains and of spheres against the walls over
 //!    the bodies' translations and rotations (generalised velocity

@@ -33,6 +33,10 @@ const PROTRUDE: f64 = 0.04;
 /// Largest growth step of the compaction (relative scale).
 const MAX_GROWTH: f64 = 0.15;
 
+/// FIRE iterations over which a relaxation must shrink its deepest overlap
+/// by a tenth, or the step counts as jammed (see `System::relax`).
+const STALL: usize = 500;
+
 /// Smallest growth step before the compaction gives up.
 const MIN_GROWTH: f64 = 2e-3;
 
@@ -599,6 +603,7 @@ impl System<'_> {
         let mut dt = DT0;
         let mut alpha = ALPHA0;
         let mut npos = 0usize;
+        let mut checkpoint = f64::INFINITY;
         self.u.iter_mut().for_each(|u| *u = [0.0; 6]);
         let lim = 0.25 * self.skin * self.skin;
         for it in 0..=max_iter {
@@ -621,6 +626,14 @@ impl System<'_> {
             }
             if it == max_iter {
                 break;
+            }
+            // A jammed step: the deepest overlap has not shrunk by a tenth
+            // over the last STALL iterations (checked from 2·STALL on).
+            if it % STALL == 0 {
+                if it >= 2 * STALL && worst > 0.9 * checkpoint {
+                    break;
+                }
+                checkpoint = worst;
             }
             stats.iterations += 1;
             let (g, s) = self.body_forces();
