@@ -830,8 +830,8 @@ pub fn orientation_fabric(poses: &[Isometry3<f64>], body_axis: &Vector3<f64>) ->
 /// Which of `points` lie inside some grain of the packing (`grains[i]` at
 /// `poses[i]`): the point sampling behind local solid fractions (a regular
 /// grid of points in a region gives the region's solid fraction as the
-/// share of points inside). Grains are found through a cell list of their
-/// centres (cells of the largest bounding diameter), a point is inside
+/// share of points inside). Grains are found through the packer's cell
+/// grid of their bounding boxes (a point looks in its own cell), a point is inside
 /// grain `i` when its body-frame position `b` has `|b| < r_i(b̂)`.
 ///
 /// # Errors
@@ -866,22 +866,13 @@ pub fn occupied(
             finite("sample point", p[k])?;
         }
     }
-    let cell = 2.0 * grains.iter().map(StarGrain::r_max).fold(0.0, f64::max);
-    let key = |x: &Vector3<f64>| {
-        [
-            (x.x / cell).floor() as i64,
-            (x.y / cell).floor() as i64,
-            (x.z / cell).floor() as i64,
-        ]
-    };
-    let mut cells: std::collections::BTreeMap<[i64; 3], Vec<u32>> =
-        std::collections::BTreeMap::new();
-    for (i, p) in poses.iter().enumerate() {
-        cells
-            .entry(key(&p.translation.vector))
-            .or_default()
-            .push(i as u32);
-    }
+    // the grains' bounding boxes in the packer's cell grid (cells of twice
+    // the median bounding radius): a point looks only in its own cell
+    let centres: Vec<Vector3<f64>> = poses.iter().map(|p| p.translation.vector).collect();
+    let reach: Vec<f64> = grains.iter().map(StarGrain::r_max).collect();
+    let mut sorted = reach.clone();
+    sorted.sort_by(f64::total_cmp);
+    let cells = relax::Cells::new(&centres, &reach, 2.0 * sorted[sorted.len() / 2]);
     let rot: Vec<Matrix3<f64>> = poses
         .iter()
         .map(|p| p.rotation.to_rotation_matrix().into_inner())
@@ -891,28 +882,12 @@ pub fn occupied(
         .with_min_len(1024)
         .map(|x| {
             let x = x.coords;
-            let k = key(&x);
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        let Some(list) = cells.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) else {
-                            continue;
-                        };
-                        for &i in list {
-                            let i = i as usize;
-                            let d = x - poses[i].translation.vector;
-                            let r = d.norm();
-                            if r < grains[i].r_max {
-                                let b = rot[i].transpose() * d;
-                                if r < grains[i].radius(&b) {
-                                    return true;
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            false
+            cells.at(&x).iter().any(|&i| {
+                let i = i as usize;
+                let d = x - centres[i];
+                let r = d.norm();
+                r < grains[i].r_max && r < grains[i].radius(&(rot[i].transpose() * d))
+            })
         })
         .collect())
 }

@@ -267,7 +267,7 @@ impl Acc {
 /// every cell its box meets (a wide grading keeps small cells: the cell is
 /// twice the median reach), and a pair is reported once, in the cell that
 /// holds the lower corner of the intersection of the two boxes.
-struct Cells {
+pub(super) struct Cells {
     lo: Vector3<f64>,
     inv: f64,
     dims: [usize; 3],
@@ -276,7 +276,7 @@ struct Cells {
 }
 
 impl Cells {
-    fn new(centres: &[Vector3<f64>], reach: &[f64], cell: f64) -> Self {
+    pub(super) fn new(centres: &[Vector3<f64>], reach: &[f64], cell: f64) -> Self {
         let mut lo = Vector3::repeat(f64::INFINITY);
         let mut hi = Vector3::repeat(f64::NEG_INFINITY);
         for (c, r) in centres.iter().zip(reach) {
@@ -328,6 +328,14 @@ impl Cells {
         grid.start = counts;
         grid.items = items;
         grid
+    }
+
+    /// The items whose boxes meet the cell holding `p` (a point outside
+    /// the grid looks in the nearest edge cell: a superset of the boxes
+    /// that hold it).
+    pub(super) fn at(&self, p: &Vector3<f64>) -> &[u32] {
+        let id = self.id(&self.coord(p));
+        &self.items[self.start[id] as usize..self.start[id + 1] as usize]
     }
 
     fn for_cells(&self, a: &[usize; 3], b: &[usize; 3], mut f: impl FnMut(usize)) {

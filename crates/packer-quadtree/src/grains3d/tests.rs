@@ -292,3 +292,28 @@ fn container_for_never_rounds_the_fraction_down() {
         }
     }
 }
+
+/// `occupied`: points inside a sphere and a turned ellipsoid, and outside
+/// both; a pose count that differs from the grain count is an error.
+#[test]
+fn occupied_finds_points_inside_grains() {
+    let g = vec![
+        StarGrain::sphere(1.0).unwrap_or_else(|e| panic!("{e}")),
+        StarGrain::ellipsoid(2.0, 0.5, 0.5, 12).unwrap_or_else(|e| panic!("{e}")),
+    ];
+    let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f64::consts::FRAC_PI_2);
+    let poses = vec![
+        Isometry3::identity(),
+        Isometry3::from_parts(Translation3::new(5.0, 0.0, 0.0), turn),
+    ];
+    let pts = [
+        Point3::new(0.9, 0.0, 0.0),  // in the sphere
+        Point3::new(1.1, 0.0, 0.0),  // between
+        Point3::new(5.0, 1.9, 0.0),  // along the turned major axis
+        Point3::new(6.9, 0.0, 0.0),  // where the unturned axis would reach
+        Point3::new(50.0, 0.0, 0.0), // far away
+    ];
+    let inside = occupied(&g, &poses, &pts).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(inside, vec![true, false, true, false, false]);
+    assert!(occupied(&g, &poses[..1], &pts).is_err());
+}
