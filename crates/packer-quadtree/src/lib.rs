@@ -104,8 +104,8 @@ pub use ga::{GaParams, GaResult, graded_layers, optimise_porosity};
 pub use grading::{Grading, MixtureComponent, estimate_count};
 pub use grains3d::{
     CheckParams, Fabric, GrainOverlapReport, GrainPackParams, GrainPackStats, GrainPacking,
-    StarGrain, check_grain_overlaps, container_for, occupied, orientation_fabric, pack_grains,
-    random_rotation,
+    StarGrain, boundary_for, check_grain_overlaps, check_grain_overlaps_in, container_for,
+    occupied, occupied_in, orientation_fabric, pack_grains, pack_grains_in, random_rotation,
 };
 pub use index::{CellGrid, MxQuadtree, SpatialIndex};
 pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};

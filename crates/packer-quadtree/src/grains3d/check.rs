@@ -18,13 +18,19 @@
 //! the finer of their check grids' spacings) over the intersection of their
 //! node bounding boxes; a voxel centre inside both star surfaces (`|p| <
 //! r(p̂)` in each body frame) is an overlap voxel (must be none).
+//!
+//! Periodic cells ([`check_grain_overlaps_in`]): the centres are wrapped
+//! into the cell and every grain within two bounding radii of a periodic
+//! face is copied as an image beyond the opposite face (its own copies,
+//! not the packer's); a pair meeting through an image is checked with the
+//! image's position, and counted in [`GrainOverlapReport::periodic_pairs`].
 
 use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::{StarGrain, fibonacci};
 use crate::error::{Error, Result, finite, positive};
-use crate::pack3d::Container;
+use crate::pack3d::{Boundary, Container};
 use levelset::{DirectionTable, Grid, GridSpec, StarParams};
 
 /// Parameters of [`check_grain_overlaps`].
@@ -61,6 +67,8 @@ pub struct GrainOverlapReport {
     pub grains: usize,
     /// Pairs whose bounding spheres meet.
     pub pairs: usize,
+    /// Of those, pairs that meet across a periodic face.
+    pub periodic_pairs: usize,
     /// Node samples taken in a neighbour's level set.
     pub nodes_checked: u64,
     /// Smallest `φ_neighbour(node) / d_eq(neighbour)` (`+inf` without samples).
@@ -104,23 +112,55 @@ fn check_grid(g: &StarGrain, resolution: usize) -> Result<Grid> {
     Ok(grid)
 }
 
-/// Checks a grain packing (see the module docs).
+/// Checks a grain packing in a container (see the module docs):
+/// [`check_grain_overlaps_in`] with the container's walls.
 ///
 /// # Errors
-/// [`Error::Empty`] without grains; [`Error::Parameter`] for bad
-/// parameters or a pose count that differs from the grain count;
-/// [`Error::NonFinite`] for a non-finite pose; container validation errors;
-/// levelset errors ([`Error::StarTable`]) from the rasterisation.
+/// As [`check_grain_overlaps_in`].
 pub fn check_grain_overlaps(
     grains: &[StarGrain],
     poses: &[Isometry3<f64>],
     container: &Container,
     params: &CheckParams,
 ) -> Result<GrainOverlapReport> {
+    check_grain_overlaps_in(grains, poses, &Boundary::Walls(container.clone()), params)
+}
+
+/// Checks a grain packing in a container or a periodic cell (see the
+/// module docs); periodic faces are not walls, pairs across them are
+/// checked through images.
+///
+/// # Errors
+/// [`Error::Empty`] without grains; [`Error::Parameter`] for bad
+/// parameters or a pose count that differs from the grain count;
+/// [`Error::NonFinite`] for a non-finite pose; boundary validation errors;
+/// [`Error::DomainTooSmall`] for a periodic side shorter than three
+/// bounding diameters of the largest grain; levelset errors
+/// ([`Error::StarTable`]) from the rasterisation.
+pub fn check_grain_overlaps_in(
+    grains: &[StarGrain],
+    poses: &[Isometry3<f64>],
+    boundary: &Boundary,
+    params: &CheckParams,
+) -> Result<GrainOverlapReport> {
     if grains.is_empty() {
         return Err(Error::Empty { what: "grain list" });
     }
-    container.validate()?;
+    let largest = grains.iter().map(|g| 2.0 * g.r_max()).fold(0.0, f64::max);
+    super::check_boundary(boundary, largest).or_else(|e| match e {
+        // a packing may hold grains the container cannot: reported by nodes outside
+        Error::DomainTooSmall { particle, .. } if particle == largest => Ok(()),
+        e => Err(e),
+    })?;
+    let (container, cell) = match boundary {
+        Boundary::Walls(c) => {
+            let (lo, hi) = c.bbox();
+            let [px, py] = c.periodic();
+            (Some(c), (lo.coords, hi.coords, [px, py, false]))
+        }
+        Boundary::Periodic { min, max } => (None, (min.coords, max.coords, [true; 3])),
+    };
+    let clearance = |p: &Point3<f64>| container.map_or(f64::INFINITY, |c| c.clearance(p));
     if poses.len() != grains.len() {
         return Err(Error::Parameter {
             what: "pose count",
@@ -153,10 +193,19 @@ pub fn check_grain_overlaps(
         .iter()
         .map(|p| p.rotation.to_rotation_matrix().into_inner())
         .collect();
-    let cs: Vec<Vector3<f64>> = poses.iter().map(|p| p.translation.vector).collect();
+    let cs: Vec<Vector3<f64>> = poses
+        .iter()
+        .map(|p| wrap(p.translation.vector, &cell))
+        .collect();
     let d_eq: Vec<f64> = grains.iter().map(StarGrain::equivalent_diameter).collect();
-    let nbrs = neighbours(grains, &cs);
+    let nbrs = neighbours(grains, &cs, &cell);
     let pairs = nbrs.iter().map(Vec::len).sum::<usize>() / 2;
+    let periodic_pairs = nbrs
+        .iter()
+        .flatten()
+        .filter(|(_, s)| *s != Vector3::zeros())
+        .count()
+        / 2;
     let dirs = fibonacci(params.nodes);
 
     // Pass 1: own grid, nodes pushed onto its zero, wall clearances.
@@ -203,7 +252,7 @@ pub fn check_grain_overlaps(
                 }
                 let p = u * t;
                 resid = resid.max(phi.abs() / d_eq[i]);
-                let cl = container.clearance(&Point3::from(rots[i] * p + cs[i])) / d_eq[i];
+                let cl = clearance(&Point3::from(rots[i] * p + cs[i])) / d_eq[i];
                 wall = wall.min(cl);
                 if cl < -params.tolerance {
                     outside += 1;
@@ -219,8 +268,11 @@ pub fn check_grain_overlaps(
     };
 
     // Pass 2: each grid again; every neighbour's nodes sampled in it.
-    // Per grid j: (samples, overlapping, worst φ/d, its node grain, per-pair minima).
-    type Pass2 = (u64, u64, f64, usize, Vec<(f64, usize, usize)>);
+    // Per grid j: (samples, overlapping, worst φ/d, its node grain, per-pair
+    // minima with the pair's lower grain, upper grain, and the shift of the
+    // upper grain's image).
+    type Minimum = (f64, usize, usize, [f64; 3]);
+    type Pass2 = (u64, u64, f64, usize, Vec<Minimum>);
     let pass2: Vec<Pass2> = (0..n)
         .into_par_iter()
         .with_min_len(8)
@@ -231,9 +283,9 @@ pub fn check_grain_overlaps(
             let mut minima = Vec::with_capacity(nbrs[j].len());
             let rt = rots[j].transpose();
             let r2 = (gj.r_max() * (1.0 + 1e-9)).powi(2);
-            for &i in &nbrs[j] {
+            for &(i, shift) in &nbrs[j] {
                 let m = rt * rots[i];
-                let t = rt * (cs[i] - cs[j]);
+                let t = rt * (cs[i] + shift - cs[j]);
                 let mut pair_min = f64::INFINITY;
                 for k in 0..dirs.len() {
                     let q = m * node(i, k) + t;
@@ -254,7 +306,9 @@ pub fn check_grain_overlaps(
                         worst_i = i;
                     }
                 }
-                minima.push((pair_min, i.min(j), i.max(j)));
+                // the upper grain's image relative to the lower one
+                let up = if i > j { shift } else { -shift };
+                minima.push((pair_min, i.min(j), i.max(j), [up.x, up.y, up.z]));
             }
             Ok((samples, bad, worst, worst_i, minima))
         })
@@ -263,6 +317,7 @@ pub fn check_grain_overlaps(
     let mut report = GrainOverlapReport {
         grains: n,
         pairs,
+        periodic_pairs,
         nodes_checked: 0,
         worst_phi_over_d: f64::INFINITY,
         worst_pair: None,
@@ -279,7 +334,7 @@ pub fn check_grain_overlaps(
         report.worst_wall_over_d = report.worst_wall_over_d.min(p.2);
         report.nodes_outside += p.3;
     }
-    let mut minima: Vec<(f64, usize, usize)> = Vec::new();
+    let mut minima: Vec<Minimum> = Vec::new();
     for (j, p) in pass2.iter().enumerate() {
         report.nodes_checked += p.0;
         report.overlapping_nodes += p.1;
@@ -291,18 +346,20 @@ pub fn check_grain_overlaps(
     }
     // Closest pairs (each unordered pair once, by its smaller minimum).
     minima.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-    let mut chosen: Vec<(usize, usize)> = Vec::new();
-    for &(_, a, b) in &minima {
+    let mut chosen: Vec<(usize, usize, Vector3<f64>)> = Vec::new();
+    for &(_, a, b, s) in &minima {
         if chosen.len() >= params.raster_pairs {
             break;
         }
-        if !chosen.contains(&(a, b)) {
-            chosen.push((a, b));
+        if !chosen.iter().any(|c| (c.0, c.1) == (a, b)) {
+            chosen.push((a, b, Vector3::from(s)));
         }
     }
     let raster: Vec<(u64, u64)> = chosen
         .par_iter()
-        .map(|&(a, b)| {
+        .map(|&(a, b, shift)| {
+            // b at its image next to a
+            let at = |i: usize| if i == b { cs[b] + shift } else { cs[i] };
             let h = [a, b]
                 .iter()
                 .map(|&i| 2.2 * grains[i].r_max() / (params.resolution - 1) as f64)
@@ -312,7 +369,7 @@ pub fn check_grain_overlaps(
                 let mut lo = Vector3::repeat(f64::INFINITY);
                 let mut hi = Vector3::repeat(f64::NEG_INFINITY);
                 for k in 0..dirs.len() {
-                    let x = rots[i] * node(i, k) + cs[i];
+                    let x = rots[i] * node(i, k) + at(i);
                     lo = lo.inf(&x);
                     hi = hi.sup(&x);
                 }
@@ -344,8 +401,8 @@ pub fn check_grain_overlaps(
                                 (z as f64 + 0.5) * step.z,
                             );
                         voxels += 1;
-                        if grains[a].contains(&(ra * (p - cs[a])))
-                            && grains[b].contains(&(rb * (p - cs[b])))
+                        if grains[a].contains(&(ra * (p - at(a))))
+                            && grains[b].contains(&(rb * (p - at(b))))
                         {
                             both += 1;
                         }
@@ -363,34 +420,97 @@ pub fn check_grain_overlaps(
     Ok(report)
 }
 
+/// The periodic cell `(lo, hi, periodic axes)` of a check.
+type Cell = (Vector3<f64>, Vector3<f64>, [bool; 3]);
+
+/// `p` moved by whole sides into `[lo, hi)` on the periodic axes.
+fn wrap(mut p: Vector3<f64>, cell: &Cell) -> Vector3<f64> {
+    for k in 0..3 {
+        if cell.2[k] {
+            let l = cell.1[k] - cell.0[k];
+            p[k] -= l * ((p[k] - cell.0[k]) / l).floor();
+            if p[k] >= cell.1[k] {
+                p[k] = cell.0[k];
+            }
+        }
+    }
+    p
+}
+
 /// For every grain, the grains whose bounding spheres meet its own (both
-/// directions), by a sweep over centres sorted by z.
-fn neighbours(grains: &[StarGrain], cs: &[Vector3<f64>]) -> Vec<Vec<usize>> {
+/// directions), each with the shift of the image it meets through (zero
+/// within the cell), by a sweep over the centres and their images sorted
+/// by z.
+fn neighbours(
+    grains: &[StarGrain],
+    cs: &[Vector3<f64>],
+    cell: &Cell,
+) -> Vec<Vec<(usize, Vector3<f64>)>> {
     let n = grains.len();
     let r_all = grains.iter().map(StarGrain::r_max).fold(0.0_f64, f64::max);
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| cs[a].z.total_cmp(&cs[b].z).then(a.cmp(&b)));
-    let zs: Vec<f64> = order.iter().map(|&i| cs[i].z).collect();
-    let mut out: Vec<Vec<usize>> = (0..n)
+    // images: every combination of shifts by ± a side towards the faces a
+    // centre is within 2 r_all of
+    let mut ext: Vec<(usize, Vector3<f64>)> = (0..n).map(|i| (i, Vector3::zeros())).collect();
+    for (i, c) in cs.iter().enumerate() {
+        let mut options: Vec<Vector3<f64>> = vec![Vector3::zeros()];
+        for k in 0..3 {
+            if !cell.2[k] {
+                continue;
+            }
+            let l = cell.1[k] - cell.0[k];
+            let s = if c[k] - cell.0[k] < 2.0 * r_all {
+                l
+            } else if cell.1[k] - c[k] < 2.0 * r_all {
+                -l
+            } else {
+                continue;
+            };
+            let more: Vec<Vector3<f64>> = options
+                .iter()
+                .map(|o| {
+                    let mut v = *o;
+                    v[k] = s;
+                    v
+                })
+                .collect();
+            options.extend(more);
+        }
+        ext.extend(options.into_iter().skip(1).map(|s| (i, s)));
+    }
+    let pos = |e: &(usize, Vector3<f64>)| cs[e.0] + e.1;
+    let mut order: Vec<usize> = (0..ext.len()).collect();
+    order.sort_by(|&a, &b| pos(&ext[a]).z.total_cmp(&pos(&ext[b]).z).then(a.cmp(&b)));
+    let zs: Vec<f64> = order.iter().map(|&e| pos(&ext[e]).z).collect();
+    let mut out: Vec<Vec<(usize, Vector3<f64>)>> = (0..n)
         .into_par_iter()
         .with_min_len(64)
         .map(|i| {
             let ri = grains[i].r_max();
             let lo = zs.partition_point(|&z| z < cs[i].z - ri - r_all);
             let mut v = Vec::new();
-            for &j in &order[lo..] {
-                if cs[j].z > cs[i].z + ri + r_all {
+            for &e in &order[lo..] {
+                let (j, shift) = ext[e];
+                let p = cs[j] + shift;
+                if p.z > cs[i].z + ri + r_all {
                     break;
                 }
-                if j != i && (cs[i] - cs[j]).norm() < ri + grains[j].r_max() {
-                    v.push(j);
+                if j != i && (cs[i] - p).norm() < ri + grains[j].r_max() {
+                    v.push((j, shift));
                 }
             }
             v
         })
         .collect();
     for v in &mut out {
-        v.sort_unstable();
+        v.sort_unstable_by(|a, b| {
+            a.0.cmp(&b.0).then_with(|| {
+                a.1.iter()
+                    .zip(b.1.iter())
+                    .fold(std::cmp::Ordering::Equal, |o, (x, y)| {
+                        o.then(x.total_cmp(y))
+                    })
+            })
+        });
     }
     out
 }

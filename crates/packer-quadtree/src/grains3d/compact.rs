@@ -9,8 +9,13 @@ use rayon::prelude::*;
 use super::StarGrain;
 #[cfg(test)]
 use super::fibonacci;
+use super::region::{NO_SHIFT, Region};
 use crate::error::{Error, Result};
-use crate::pack3d::Container;
+
+/// Bits of a neighbour-list entry that hold the sphere index; the top
+/// five hold its periodic image (0: none, else the shift code + 1).
+const INDEX_BITS: u32 = 27;
+const INDEX_MASK: u32 = (1 << INDEX_BITS) - 1;
 
 /// Spheres per chunk of the parallel passes (fixed, so sums are added in
 /// the same order for any thread count).
@@ -278,7 +283,9 @@ struct Sums {
 
 struct System<'a> {
     proxy: &'a Proxy,
-    container: &'a Container,
+    region: &'a Region<'a>,
+    /// Translations of the 28 image codes of a list entry (see `INDEX_BITS`).
+    shifts: [[f64; 3]; 28],
     /// Sphere → body.
     body: Vec<u32>,
     c: Vec<Vector3<f64>>,
@@ -329,6 +336,12 @@ impl System<'_> {
     /// bounding spheres are that close, each side culled to its spheres
     /// near the other grain.
     fn build(&mut self) {
+        let region = self.region;
+        if region.is_periodic() {
+            for c in &mut self.c {
+                *c = region.wrap(c);
+            }
+        }
         self.place();
         let n = self.c.len();
         let (proxy, x, c, skin) = (self.proxy, &self.x, &self.c, self.skin);
@@ -344,8 +357,14 @@ impl System<'_> {
                     .fold(0.0, f64::max)
             })
             .collect();
-        let (lo, hi) = self.container.bbox();
         let reach = 2.0 * bound.iter().copied().fold(0.0, f64::max) + skin;
+        // the centres and their periodic images within reach of a face
+        let (ext, real, code) = region.extended(c, reach);
+        let (mut lo, mut hi) = region.bbox();
+        for p in &ext {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
         let mut dims = [1usize; 3];
         let mut side = [0.0; 3];
         for k in 0..3 {
@@ -367,7 +386,7 @@ impl System<'_> {
         };
         let ncell = dims[0] * dims[1] * dims[2];
         let mut head = vec![0u32; ncell + 1];
-        let cells: Vec<usize> = c
+        let cells: Vec<usize> = ext
             .iter()
             .map(|p| {
                 let q = cell_of(p);
@@ -381,7 +400,7 @@ impl System<'_> {
             head[i + 1] += head[i];
         }
         let mut fill = head.clone();
-        let mut order = vec![0u32; n];
+        let mut order = vec![0u32; ext.len()];
         for (i, &q) in cells.iter().enumerate() {
             order[fill[q] as usize] = i as u32;
             fill[q] += 1;
@@ -398,11 +417,11 @@ impl System<'_> {
                     for cy in q[1].saturating_sub(1)..=(q[1] + 1).min(dims[1] - 1) {
                         for cx in q[0].saturating_sub(1)..=(q[0] + 1).min(dims[0] - 1) {
                             let cell = (cz * dims[1] + cy) * dims[0] + cx;
-                            for &j in &order[head[cell] as usize..head[cell + 1] as usize] {
-                                let j = j as usize;
+                            for &e in &order[head[cell] as usize..head[cell + 1] as usize] {
+                                let j = real[e as usize] as usize;
                                 let cut = bound[i] + bound[j] + skin;
-                                if j != i && (c[i] - c[j]).norm_squared() < cut * cut {
-                                    others.push(j);
+                                if j != i && (c[i] - ext[e as usize]).norm_squared() < cut * cut {
+                                    others.push(e as usize);
                                 }
                             }
                         }
@@ -410,20 +429,27 @@ impl System<'_> {
                 }
                 others.sort_unstable();
                 // world bounds of the clusters of grain b (empty ones: radius < 0)
-                let clusters = |b: usize| -> [(Vector3<f64>, f64); CLUSTERS] {
+                let clusters = |b: usize, at: &Vector3<f64>| -> [(Vector3<f64>, f64); CLUSTERS] {
                     let mut out = [(Vector3::zeros(), -1.0); CLUSTERS];
                     for (k, o) in out.iter_mut().enumerate() {
                         let (cc, rr) = proxy.bounds[b * CLUSTERS + k];
                         if rr >= 0.0 {
-                            *o = (c[b] + rot[b] * (lam * cc), lam * rr + eps[b]);
+                            *o = (at + rot[b] * (lam * cc), lam * rr + eps[b]);
                         }
                     }
                     out
                 };
-                let ci = clusters(i);
+                let ci = clusters(i, &c[i]);
                 let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(mine.len() * 8);
-                for &j in &others {
-                    let cj = clusters(j);
+                for &e in &others {
+                    let j = real[e] as usize;
+                    let sh = ext[e] - c[j];
+                    let tag = if code[e] == NO_SHIFT {
+                        0
+                    } else {
+                        (u32::from(code[e]) + 1) << INDEX_BITS
+                    };
+                    let cj = clusters(j, &ext[e]);
                     for (a, (pa, ra)) in ci.iter().enumerate() {
                         if *ra < 0.0 {
                             continue;
@@ -439,11 +465,14 @@ impl System<'_> {
                                 proxy.groups[j * CLUSTERS + b]..proxy.groups[j * CLUSTERS + b + 1];
                             for s in ga {
                                 for t in gb.clone() {
-                                    let d =
-                                        [x[s][0] - x[t][0], x[s][1] - x[t][1], x[s][2] - x[t][2]];
+                                    let d = [
+                                        x[s][0] - x[t][0] - sh.x,
+                                        x[s][1] - x[t][1] - sh.y,
+                                        x[s][2] - x[t][2] - sh.z,
+                                    ];
                                     let cut = x[s][3] + x[t][3] + skin;
                                     if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut {
-                                        pairs.push((s as u32, t as u32));
+                                        pairs.push((s as u32, t as u32 | tag));
                                     }
                                 }
                             }
@@ -470,20 +499,19 @@ impl System<'_> {
             }
         }
         self.x_build.clone_from(&self.x);
-        let container = self.container;
         self.walled = self
             .x
             .par_iter()
             .with_min_len(1024)
-            .map(|p| container.clearance(&Point3::new(p[0], p[1], p[2])) < p[3] + skin)
+            .map(|p| region.clearance(&Point3::new(p[0], p[1], p[2])) < p[3] + skin)
             .collect();
         self.built = true;
     }
 
     /// Sphere forces into `self.f`; the largest overlap (pairs and walls).
     fn sphere_forces(&mut self) -> f64 {
-        let (x, start, list, container) = (&self.x, &self.start, &self.list, self.container);
-        let walled = &self.walled;
+        let (x, start, list, region) = (&self.x, &self.start, &self.list, self.region);
+        let (walled, shifts) = (&self.walled, &self.shifts);
         self.f
             .par_chunks_mut(CHUNK)
             .enumerate()
@@ -493,9 +521,14 @@ impl System<'_> {
                     let i = ch * CHUNK + o;
                     let a = &x[i];
                     let mut acc = [0.0; 3];
-                    for &j in &list[start[i] as usize..start[i + 1] as usize] {
-                        let b = &x[j as usize];
-                        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                    for &e in &list[start[i] as usize..start[i + 1] as usize] {
+                        let b = &x[(e & INDEX_MASK) as usize];
+                        let sh = &shifts[(e >> INDEX_BITS) as usize];
+                        let d = [
+                            a[0] - b[0] - sh[0],
+                            a[1] - b[1] - sh[1],
+                            a[2] - b[2] - sh[2],
+                        ];
                         let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                         let cut = a[3] + b[3];
                         if dd >= cut * cut {
@@ -511,7 +544,7 @@ impl System<'_> {
                     }
                     if walled[i] {
                         let p = Point3::new(a[0], a[1], a[2]);
-                        let cl = container.clearance(&p);
+                        let cl = region.clearance(&p);
                         if cl < a[3] {
                             let ov = a[3] - cl;
                             worst = worst.max(ov);
@@ -522,8 +555,7 @@ impl System<'_> {
                                 let mut w = p;
                                 e[k] += h;
                                 w[k] -= h;
-                                g[k] =
-                                    (container.clearance(&e) - container.clearance(&w)) / (2.0 * h);
+                                g[k] = (region.clearance(&e) - region.clearance(&w)) / (2.0 * h);
                             }
                             let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
                             if len > 0.0 {
@@ -690,7 +722,7 @@ impl System<'_> {
     }
 }
 
-/// Grows the grains' proxies from scale `lam0` to 1 inside `container`,
+/// Grows the grains' proxies from scale `lam0` to 1 inside `region`,
 /// moving `centres` and `quats` (FIRE on rigid clumps: see the parent
 /// module).
 ///
@@ -700,7 +732,7 @@ impl System<'_> {
 pub(super) fn compact(
     grains: &[StarGrain],
     proxy: &Proxy,
-    container: &Container,
+    region: &Region<'_>,
     centres: &mut [Vector3<f64>],
     quats: &mut [UnitQuaternion<f64>],
     lam0: f64,
@@ -716,9 +748,22 @@ pub(super) fn compact(
     for i in 0..n {
         body[proxy.start[i]..proxy.start[i + 1]].fill(i as u32);
     }
+    if proxy.len() > INDEX_MASK as usize {
+        return Err(Error::Parameter {
+            what: "proxy spheres in all",
+            value: proxy.len() as f64,
+            range: "[1, 2^27)",
+        });
+    }
+    let mut shifts = [[0.0; 3]; 28];
+    for (code, s) in shifts.iter_mut().enumerate().skip(1) {
+        let v = region.shift((code - 1) as u8);
+        *s = [v.x, v.y, v.z];
+    }
     let mut sys = System {
         proxy,
-        container,
+        region,
+        shifts,
         body,
         c: centres.to_vec(),
         q: quats.to_vec(),
@@ -789,11 +834,14 @@ fn not_converged(sys: &mut System<'_>, stats: &CompactStats, lam: f64) -> Error 
     let x = &sys.x;
     let mut pairs = std::collections::BTreeSet::new();
     for i in 0..x.len() {
-        for &j in &sys.list[sys.start[i] as usize..sys.start[i + 1] as usize] {
+        for &e in &sys.list[sys.start[i] as usize..sys.start[i + 1] as usize] {
+            let j = e & INDEX_MASK;
             let b = &x[j as usize];
-            let d =
-                ((x[i][0] - b[0]).powi(2) + (x[i][1] - b[1]).powi(2) + (x[i][2] - b[2]).powi(2))
-                    .sqrt();
+            let sh = &sys.shifts[(e >> INDEX_BITS) as usize];
+            let d = ((x[i][0] - b[0] - sh[0]).powi(2)
+                + (x[i][1] - b[1] - sh[1]).powi(2)
+                + (x[i][2] - b[2] - sh[2]).powi(2))
+            .sqrt();
             if x[i][3] + b[3] - d > sys.tol {
                 let (p, q) = (sys.body[i], sys.body[j as usize]);
                 pairs.insert((p.min(q), p.max(q)));
@@ -913,7 +961,7 @@ mod compaction_tests {
         let st = compact(
             &grains,
             &proxy,
-            &cont,
+            &Region::of(&cont),
             &mut centres,
             &mut q,
             lam0,

@@ -4,9 +4,9 @@
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 
+use super::region::Region;
 use super::{GrainPackParams, GrainPackStats, StarGrain, fibonacci, to_world};
 use crate::error::{Error, Result};
-use crate::pack3d::Container;
 
 /// Patches per node set (each with a bounding sphere per grain).
 const PATCHES: usize = 32;
@@ -223,12 +223,12 @@ impl<'a> Shapes<'a> {
         r: &Matrix3<f64>,
         c: &Vector3<f64>,
         lam: f64,
-        container: &Container,
+        region: &Region<'_>,
     ) -> (f64, Vector3<f64>) {
         let mut worst = (f64::INFINITY, *c);
         for k in 0..self.set.dirs.len() {
             let x = to_world(r, c, &(lam * self.node(i, k)));
-            let cl = container.clearance(&x);
+            let cl = region.clearance(&x);
             if cl < worst.0 {
                 worst = (cl, x.coords);
             }
@@ -365,27 +365,15 @@ impl Cells {
         q[0] + self.dims[0] * (q[1] + self.dims[1] * q[2])
     }
 
-    /// Calls `f(j)` once for every `j > i` whose box meets grain `i`'s.
-    fn pairs_of(&self, i: usize, c: &[Vector3<f64>], reach: &[f64], f: impl FnMut(usize)) {
-        self.meeting(i, c, reach, true, f);
-    }
-
-    /// Calls `f(j)` once for every `j ≠ i` (only `j > i` when `upper`)
-    /// whose box meets grain `i`'s.
-    fn meeting(
-        &self,
-        i: usize,
-        c: &[Vector3<f64>],
-        reach: &[f64],
-        upper: bool,
-        mut f: impl FnMut(usize),
-    ) {
+    /// Calls `f(j)` once for every item `j ≠ i` whose box meets item
+    /// `i`'s.
+    fn meeting(&self, i: usize, c: &[Vector3<f64>], reach: &[f64], mut f: impl FnMut(usize)) {
         let (lo_i, hi_i) = (c[i].add_scalar(-reach[i]), c[i].add_scalar(reach[i]));
         let (a, b) = (self.coord(&lo_i), self.coord(&hi_i));
         self.for_cells(&a, &b, |id| {
             for &j in &self.items[self.start[id] as usize..self.start[id + 1] as usize] {
                 let j = j as usize;
-                if j == i || (upper && j < i) {
+                if j == i {
                     continue;
                 }
                 let lo_j = c[j].add_scalar(-reach[j]);
@@ -443,36 +431,68 @@ struct Frame {
     cell: f64,
 }
 
+/// The grains' centres (wrapped into a periodic cell) and their periodic
+/// images, in a cell grid of their bounding boxes.
+struct Near {
+    /// Centres, then images.
+    c: Vec<Vector3<f64>>,
+    /// Grain of each entry.
+    real: Vec<u32>,
+    reach: Vec<f64>,
+    cells: Cells,
+}
+
+impl Near {
+    fn new(frame: &Frame, region: &Region<'_>, centres: &[Vector3<f64>]) -> Self {
+        let width = 2.0 * frame.reach.iter().copied().fold(0.0, f64::max);
+        let (c, real, _) = region.extended(centres, width);
+        let reach: Vec<f64> = real.iter().map(|&r| frame.reach[r as usize]).collect();
+        let cells = Cells::new(&c, &reach, frame.cell);
+        Self {
+            c,
+            real,
+            reach,
+            cells,
+        }
+    }
+}
+
 impl Frame {
-    /// Both-way node test of `(a, b)`.
-    fn pair(&self, s: &Shapes<'_>, a: usize, b: usize, c: &[Vector3<f64>], lam: f64) -> Acc {
+    /// Both-way node test of `a` at `ca` and `b` at `cb`.
+    fn pair(
+        &self,
+        s: &Shapes<'_>,
+        a: usize,
+        b: usize,
+        ca: &Vector3<f64>,
+        cb: &Vector3<f64>,
+        lam: f64,
+    ) -> Acc {
         let mut acc = Acc::new();
-        let (pa, pb) = ((&self.rots[a], &c[a]), (&self.rots[b], &c[b]));
+        let (pa, pb) = ((&self.rots[a], ca), (&self.rots[b], cb));
         s.one_way(a, b, pa, pb, self.mu[b], self.d_eq[b], 1.0, lam, &mut acc);
         s.one_way(b, a, pb, pa, self.mu[a], self.d_eq[a], -1.0, lam, &mut acc);
         acc
     }
 
-    /// Grains `j ≠ i` in reach of `i`.
-    fn for_neighbours(
-        &self,
-        cells: &Cells,
-        c: &[Vector3<f64>],
-        i: usize,
-        mut f: impl FnMut(usize),
-    ) {
-        cells.meeting(i, c, &self.reach, false, |j| {
-            if (c[i] - c[j]).norm_squared() < (self.reach[i] + self.reach[j]).powi(2) {
-                f(j);
+    /// Grains `j ≠ i` in reach of grain `i`, each with the centre of the
+    /// image (or the grain itself) that meets it.
+    fn for_neighbours(&self, near: &Near, i: usize, mut f: impl FnMut(usize, &Vector3<f64>)) {
+        let c = &near.c;
+        near.cells.meeting(i, c, &near.reach, |e| {
+            let j = near.real[e] as usize;
+            if j != i && (c[i] - c[e]).norm_squared() < (self.reach[i] + self.reach[j]).powi(2) {
+                f(j, &c[e]);
             }
         });
     }
 
-    /// Pairs `(i, j > i)` in reach.
-    fn for_pairs(&self, cells: &Cells, c: &[Vector3<f64>], i: usize, mut f: impl FnMut(usize)) {
-        cells.pairs_of(i, c, &self.reach, |j| {
-            if (c[i] - c[j]).norm_squared() < (self.reach[i] + self.reach[j]).powi(2) {
-                f(j);
+    /// Pairs `(i, j > i)` in reach (each once, directly or through one
+    /// image).
+    fn for_pairs(&self, near: &Near, i: usize, mut f: impl FnMut(usize, &Vector3<f64>)) {
+        self.for_neighbours(near, i, |j, cj| {
+            if j > i {
+                f(j, cj);
             }
         });
     }
@@ -485,7 +505,7 @@ type Poses = (Vec<Vector3<f64>>, Vec<UnitQuaternion<f64>>);
 /// the margin (fine node set), or [`Error::NotConverged`].
 pub(super) fn relax(
     grains: &[StarGrain],
-    container: &Container,
+    region: &Region<'_>,
     rotations: &[UnitQuaternion<f64>],
     mut centres: Vec<Vector3<f64>>,
     lam0: f64,
@@ -536,7 +556,7 @@ pub(super) fn relax(
         let clean = relax_at(
             &mut frame,
             &coarse,
-            container,
+            region,
             &mut centres,
             &mut moved,
             lam,
@@ -572,7 +592,7 @@ pub(super) fn relax(
     relax_at(
         &mut frame,
         &shapes,
-        container,
+        region,
         &mut centres,
         &mut moved,
         1.0,
@@ -585,22 +605,22 @@ pub(super) fn relax(
     )?;
     stats.fine_sweeps = sweeps - stats.coarse_sweeps;
     stats.growth_start = lam0;
-    let cells = Cells::new(&centres, &frame.reach, frame.cell);
+    for c in &mut centres {
+        *c = region.wrap(c);
+    }
+    let near = Near::new(&frame, region, &centres);
     let fin: Vec<(f64, usize, f64)> = (0..n)
         .into_par_iter()
         .with_min_len(16)
         .map(|i| {
             let mut gap = f64::INFINITY;
-            let mut near = 0;
-            frame.for_pairs(&cells, &centres, i, |j| {
-                near += 1;
-                gap = gap.min(frame.pair(&shapes, i, j, &centres, 1.0).min_gap);
+            let mut count = 0;
+            frame.for_pairs(&near, i, |j, cj| {
+                count += 1;
+                gap = gap.min(frame.pair(&shapes, i, j, &centres[i], cj, 1.0).min_gap);
             });
-            let wall = shapes
-                .wall(i, &frame.rots[i], &centres[i], 1.0, container)
-                .0
-                / frame.d_eq[i];
-            (gap, near, wall)
+            let wall = shapes.wall(i, &frame.rots[i], &centres[i], 1.0, region).0 / frame.d_eq[i];
+            (gap, count, wall)
         })
         .collect();
     stats.worst_gap_over_d = fin.iter().map(|f| f.0).fold(f64::INFINITY, f64::min);
@@ -626,7 +646,7 @@ const GROWTH_SWEEPS: usize = 40;
 fn relax_at(
     frame_mut: &mut Frame,
     shapes: &Shapes<'_>,
-    container: &Container,
+    region: &Region<'_>,
     centres: &mut [Vector3<f64>],
     moved: &mut [bool],
     lam: f64,
@@ -639,16 +659,21 @@ fn relax_at(
 ) -> Result<bool> {
     let n = centres.len();
     for _ in 0..budget {
+        if region.is_periodic() {
+            for c in centres.iter_mut() {
+                *c = region.wrap(c);
+            }
+        }
         let frame: &Frame = frame_mut;
+        let near = Near::new(frame, region, centres);
         if *sweeps >= max_sweeps {
-            let cells = Cells::new(centres, &frame.reach, frame.cell);
             let c: &[Vector3<f64>] = centres;
             let left: usize = (0..n)
                 .into_par_iter()
                 .map(|i| {
                     let mut cnt = 0;
-                    frame.for_pairs(&cells, c, i, |j| {
-                        if frame.pair(shapes, i, j, c, lam).depth > 0.0 {
+                    frame.for_pairs(&near, i, |j, cj| {
+                        if frame.pair(shapes, i, j, &c[i], cj, lam).depth > 0.0 {
                             cnt += 1;
                         }
                     });
@@ -662,7 +687,6 @@ fn relax_at(
             });
         }
         *sweeps += 1;
-        let cells = Cells::new(centres, &frame.reach, frame.cell);
         let c: &[Vector3<f64>] = centres;
         let mv: &[bool] = moved;
         // Only pairs with a moved grain: each is tested from its moved
@@ -674,18 +698,18 @@ fn relax_at(
             .map(|&i| {
                 let mut out = Vec::new();
                 let mut tests = 0;
-                frame.for_neighbours(&cells, c, i, |j| {
+                frame.for_neighbours(&near, i, |j, cj| {
                     if mv[j] && j < i {
                         return;
                     }
                     tests += 1;
-                    let acc = frame.pair(shapes, i, j, c, lam);
+                    let acc = frame.pair(shapes, i, j, &c[i], cj, lam);
                     if acc.depth > 0.0 {
                         let mut dir = acc.dir;
                         if dir.norm().partial_cmp(&(1e-12 * acc.depth))
                             != Some(std::cmp::Ordering::Greater)
                         {
-                            dir = c[i] - c[j];
+                            dir = c[i] - cj;
                         }
                         let len = dir.norm();
                         let dir = if len > 0.0 { dir / len } else { Vector3::z() };
@@ -694,12 +718,12 @@ fn relax_at(
                         let x = if acc.weight > 0.0 {
                             acc.point / acc.weight
                         } else {
-                            0.5 * (c[i] + c[j])
+                            0.5 * (c[i] + cj)
                         };
                         out.push(Push {
                             b: j,
                             move_a: rigid_move(&(x - c[i]), &dir, step, frame.k2[i]),
-                            move_b: rigid_move(&(x - c[j]), &(-dir), step, frame.k2[j]),
+                            move_b: rigid_move(&(x - cj), &(-dir), step, frame.k2[j]),
                             depth_over_d: acc.depth / frame.d_eq[i].min(frame.d_eq[j]),
                         });
                     }
@@ -750,14 +774,14 @@ fn relax_at(
             .into_par_iter()
             .with_min_len(64)
             .map(|i| {
-                if container.clearance(&c[i].into()) >= lam * frame.reach[i] {
+                if region.clearance(&c[i].into()) >= lam * frame.reach[i] {
                     return None;
                 }
                 let mut p = c[i];
                 let mu = frame.mu[i];
                 let mut changed = false;
                 for _ in 0..6 {
-                    let (cl, x) = shapes.wall(i, &frame.rots[i], &p, lam, container);
+                    let (cl, x) = shapes.wall(i, &frame.rots[i], &p, lam, region);
                     if cl >= mu {
                         break;
                     }
@@ -766,8 +790,8 @@ fn relax_at(
                     for a in 0..3 {
                         let mut e = Vector3::zeros();
                         e[a] = h;
-                        g[a] = (container.clearance(&(x + e).into())
-                            - container.clearance(&(x - e).into()))
+                        g[a] = (region.clearance(&(x + e).into())
+                            - region.clearance(&(x - e).into()))
                             / (2.0 * h);
                     }
                     let len = g.norm();

@@ -137,14 +137,23 @@ fn bad_input_is_an_error() {
     ));
     assert!(StarGrain::sphere(f64::INFINITY).is_err());
     let small = spheres(10, 1);
+    // a periodic side under 3 bounding diameters (3 · 1.2)
     let periodic = Container::Box {
         min: Point3::origin(),
-        max: Point3::new(5.0, 5.0, 5.0),
+        max: Point3::new(3.4, 5.0, 5.0),
         periodic: [true, false],
     };
     assert!(matches!(
         pack_grains(&small, &periodic, &p),
-        Err(Error::WrongContainer { .. })
+        Err(Error::DomainTooSmall { particle, .. }) if (particle - 3.6).abs() < 0.2
+    ));
+    let cell = Boundary::Periodic {
+        min: Point3::origin(),
+        max: Point3::new(5.0, f64::NAN, 5.0),
+    };
+    assert!(matches!(
+        pack_grains_in(&small, &cell, &p),
+        Err(Error::NonFinite { .. })
     ));
     let dense = container_for(&c, &small, 0.7).unwrap_or_else(|e| panic!("{e}"));
     let tiny = Container::Cylinder {
@@ -217,6 +226,8 @@ fn packing_is_identical_for_1_and_2_threads() {
     assert_eq!(digest(&a), digest(&b));
     assert_eq!(a.stats, b.stats);
     println!("digest {:#018x}", digest(&a));
+    // minted at 55bdf72, unchanged by the periodic cells
+    assert_eq!(digest(&a), 0xa2e8_18f7_af25_c903);
 }
 
 proptest! {
@@ -316,4 +327,121 @@ fn occupied_finds_points_inside_grains() {
     let inside = occupied(&g, &poses, &pts).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(inside, vec![true, false, true, false, false]);
     assert!(occupied(&g, &poses[..1], &pts).is_err());
+}
+
+/// Minimum-image distance of two centres in a cell of sides `l` (0: walled axis).
+fn image_distance(a: &Vector3<f64>, b: &Vector3<f64>, l: [f64; 3]) -> f64 {
+    let mut d = a - b;
+    for k in 0..3 {
+        if l[k] > 0.0 {
+            d[k] -= l[k] * (d[k] / l[k]).round();
+        }
+    }
+    d.norm()
+}
+
+/// Spheres in a fully periodic cell and in a box periodic in x and y:
+/// exact minimum-image distances (the oracle) keep every pair apart,
+/// pairs across the faces exist, nothing crosses the z walls of the box,
+/// and the independent check agrees.
+#[test]
+fn periodic_cells_keep_pairs_apart_across_faces() {
+    let g = spheres(300, 11);
+    let total: f64 = g.iter().map(StarGrain::volume).sum();
+    let side = (total / 0.55).cbrt();
+    let cells = [
+        (
+            Boundary::Periodic {
+                min: Point3::new(-1.0, 0.0, 2.0),
+                max: Point3::new(side - 1.0, side, side + 2.0),
+            },
+            [side; 3],
+        ),
+        (
+            Boundary::Walls(Container::Box {
+                min: Point3::origin(),
+                max: Point3::new(side, side, side),
+                periodic: [true, true],
+            }),
+            [side, side, 0.0],
+        ),
+    ];
+    for (cell, l) in &cells {
+        let p =
+            pack_grains_in(&g, cell, &GrainPackParams::default()).unwrap_or_else(|e| panic!("{e}"));
+        let c: Vec<Vector3<f64>> = p.poses.iter().map(|q| q.translation.vector).collect();
+        let (mut across, mut worst) = (0, f64::INFINITY);
+        for i in 0..g.len() {
+            for j in i + 1..g.len() {
+                let d = image_distance(&c[i], &c[j], *l);
+                worst = worst.min(d - g[i].r_max() - g[j].r_max());
+                if d < 1.3 * (g[i].r_max() + g[j].r_max()) && (c[i] - c[j]).norm() > 0.5 * l[0] {
+                    across += 1;
+                }
+            }
+        }
+        assert!(worst >= 0.0, "pair closer than contact by {worst}");
+        assert!(across > 10, "only {across} near pairs across the faces");
+        let (lo, hi) = match cell {
+            Boundary::Periodic { min, max } => (*min, *max),
+            Boundary::Walls(w) => w.bbox(),
+        };
+        for (q, gi) in c.iter().zip(&g) {
+            for k in 0..3 {
+                assert!(q[k] >= lo[k] && q[k] < hi[k], "centre {q:?} not wrapped");
+            }
+            if l[2] == 0.0 {
+                assert!(q.z - gi.r_max() >= lo.z && q.z + gi.r_max() <= hi.z);
+            }
+        }
+        let r = check_grain_overlaps_in(&g, &p.poses, cell, &CheckParams::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        // apart spheres: no bounding spheres meet
+        assert!(r.is_clean() && r.pairs == 0, "{r:?}");
+        // ellipsoids: the independent check sees pairs through the faces
+        let e = ellipsoids(300, 5);
+        let ve: f64 = e.iter().map(StarGrain::volume).sum();
+        let cell = boundary_for(cell, &e, 0.55).unwrap_or_else(|e| panic!("{e}"));
+        assert_relative_eq!(ve / cell.volume(), 0.55, max_relative = 1e-9);
+        let p = pack_grains_in(&e, &cell, &GrainPackParams::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let r = check_grain_overlaps_in(&e, &p.poses, &cell, &CheckParams::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(r.is_clean(), "{r:?}");
+        assert!(r.periodic_pairs > 10, "{r:?}");
+    }
+}
+
+/// The check finds an overlap across a periodic face (and none when the
+/// pair is apart through it), occupied_in finds points through images.
+#[test]
+fn check_and_sampling_see_through_periodic_faces() {
+    let g = spheres(2, 3);
+    let cell = Boundary::Periodic {
+        min: Point3::origin(),
+        max: Point3::new(5.0, 5.0, 5.0),
+    };
+    let at = |x: f64| Isometry3::translation(x, 2.5, 2.5);
+    let (ra, rb) = (g[0].r_max(), g[1].r_max());
+    // 0.1 apart through the x faces, then overlapping by 0.1
+    for (gap, clean) in [(0.1, true), (-0.1, false)] {
+        let poses = [at(0.0), at(5.0 - ra - rb - gap)];
+        let r = check_grain_overlaps_in(&g, &poses, &cell, &CheckParams::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(r.periodic_pairs, usize::from(!clean));
+        assert_eq!(r.is_clean(), clean, "{r:?}");
+        assert_eq!(r.nodes_outside, 0);
+    }
+    // a sphere on a corner of the cell fills all eight corners
+    let poses = [Isometry3::translation(0.0, 0.0, 0.0), at(2.5)];
+    let corners: Vec<Point3<f64>> = (0..8)
+        .map(|k| {
+            let f = |b: usize| if k & b == 0 { 0.05 } else { 4.95 };
+            Point3::new(f(1), f(2), f(4))
+        })
+        .collect();
+    let inside = occupied_in(&g, &poses, &cell, &corners).unwrap_or_else(|e| panic!("{e}"));
+    assert!(inside.iter().all(|&b| b), "{inside:?}");
+    let walled = occupied(&g, &poses, &corners).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(walled.iter().filter(|&&b| b).count(), 1);
 }
