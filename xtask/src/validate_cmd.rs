@@ -20,6 +20,10 @@ pub(crate) struct Validate {
     /// Run only the fast subset (what `cargo test` runs).
     #[arg(long)]
     fast: bool,
+    /// Also run the heavy cases (tens of minutes on 2 cores, e.g.
+    /// `specimen/scale`; not part of CI).
+    #[arg(long)]
+    heavy: bool,
     /// Print only the summary and the failing rows.
     #[arg(long)]
     quiet: bool,
@@ -30,6 +34,7 @@ impl Validate {
         let options = validate::RunOptions {
             filter: self.filter.clone(),
             fast_only: self.fast,
+            heavy: self.heavy,
         };
         let start = Instant::now();
         let report = validate::run(

@@ -16,7 +16,11 @@
 //! ```
 //! use validate::{registry, expected_failures, run, RunOptions};
 //!
-//! let options = RunOptions { filter: Some("fixtures/gsc2018-table4".into()), fast_only: true };
+//! let options = RunOptions {
+//!     filter: Some("fixtures/gsc2018-table4".into()),
+//!     fast_only: true,
+//!     heavy: false,
+//! };
 //! let report = run(&registry(), &expected_failures(), &options);
 //! let summary = report.verdict().expect("table 4 averages are consistent");
 //! assert!(summary.passed > 0);
@@ -52,6 +56,7 @@ mod tests {
             &RunOptions {
                 filter: None,
                 fast_only: true,
+                heavy: false,
             },
         );
         if let Err(err) = report.verdict() {

@@ -47,6 +47,9 @@ pub struct Case {
     pub description: &'static str,
     /// Whether the case belongs to the fast subset that `cargo test` runs.
     pub fast: bool,
+    /// Too long for every run (tens of minutes on 2 cores): runs only with
+    /// [`RunOptions::heavy`] (`cargo xtask validate --heavy`).
+    pub heavy: bool,
     /// Computes the case's checks.
     pub run: fn() -> Result<Vec<Check>, Error>,
 }
@@ -135,6 +138,8 @@ pub struct RunOptions {
     pub filter: Option<String>,
     /// Only the fast subset.
     pub fast_only: bool,
+    /// Also the heavy cases ([`Case::heavy`]).
+    pub heavy: bool,
 }
 
 /// The result table of a run.
@@ -152,7 +157,7 @@ pub struct Report {
 pub fn run(cases: &[Case], expected: &[ExpectedFailure], options: &RunOptions) -> Report {
     let mut report = Report::default();
     for case in cases {
-        if options.fast_only && !case.fast {
+        if (options.fast_only && !case.fast) || (case.heavy && !options.heavy) {
             continue;
         }
         if let Some(filter) = &options.filter

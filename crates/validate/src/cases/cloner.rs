@@ -19,6 +19,7 @@ pub(crate) fn cases() -> Vec<Case> {
         name: "cloner/gsc2018-trial4-calibrated",
         description: "GSC 2.0 clones of the 71 default Ottawa parents at the calibrated configuration: Tables 4–5 errors ≤ the seed's trial 4; issue targets; committed scores reproduced",
         fast: false,
+        heavy: false,
         run: calibrated,
     }]
 }

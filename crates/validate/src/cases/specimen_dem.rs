@@ -50,18 +50,21 @@ pub(crate) fn cases() -> Vec<Case> {
             name: "specimen/lsdem-files",
             description: "60 packed Ottawa clones as an LS-DEM input folder read back as LS-DEM does: no missing morph file, each morph's level set principal (|I_ij|/I_max <= 1e-9), positions + rotations reproduce the world surface to 1e-9 d, reused morphs resolve",
             fast: false,
+            heavy: false,
             run: lsdem_files,
         },
         Case {
             name: "specimen/clump-mass",
             description: "200 packed Ottawa clones as trimmed clumps of 10/20/50 spheres: union volume, centroid and inertia against the level set's; the naive sum of sphere masses reported",
             fast: false,
+            heavy: false,
             run: clump_mass,
         },
         Case {
             name: "specimen/clump-shape",
             description: "DNA (volume, V/S, aspect ratio, roundness) of the delivered clumps of 200 packed Ottawa clones against their level sets, 10/20/50 spheres",
             fast: false,
+            heavy: false,
             run: clump_shape,
         },
     ]

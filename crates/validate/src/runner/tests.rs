@@ -33,6 +33,7 @@ const KINDS: Case = Case {
     name: "test/kinds",
     description: "every tolerance kind",
     fast: true,
+    heavy: false,
     run: all_kinds,
 };
 
@@ -41,6 +42,7 @@ fn case(name: &'static str, fast: bool, run: fn() -> Result<Vec<Check>, Error>) 
         name,
         description: "test",
         fast,
+        heavy: false,
         run,
     }
 }
@@ -93,6 +95,7 @@ fn zero_cases_is_a_failure() {
         &RunOptions {
             filter: Some("no-such-case".into()),
             fast_only: false,
+            heavy: false,
         },
     );
     assert_eq!(report.verdict(), Err(Error::NoCaseRan));
@@ -175,6 +178,7 @@ fn stale_entry_fails_only_when_its_case_ran() {
         &RunOptions {
             filter: Some("d/".into()),
             fast_only: false,
+            heavy: false,
         },
     );
     assert!(report.verdict().is_ok());
@@ -204,10 +208,35 @@ fn fast_only_skips_slow_cases() {
         &RunOptions {
             filter: None,
             fast_only: true,
+            heavy: false,
         },
     );
     assert_eq!(report.cases_run, vec!["a/fast".to_owned()]);
     assert!(report.verdict().is_ok());
+}
+
+#[test]
+fn heavy_cases_run_only_when_asked() {
+    let mut big = case("a/heavy", false, one_pass);
+    big.heavy = true;
+    let cases = [case("a/slow", false, one_pass), big];
+    let ran = |heavy: bool, filter: Option<&str>| {
+        run(
+            &cases,
+            &[],
+            &RunOptions {
+                filter: filter.map(str::to_owned),
+                fast_only: false,
+                heavy,
+            },
+        )
+        .cases_run
+    };
+    assert_eq!(ran(false, None), vec!["a/slow".to_owned()]);
+    assert_eq!(ran(true, None).len(), 2);
+    // a filter alone does not run it either
+    assert_eq!(ran(false, Some("a/heavy")), Vec::<String>::new());
+    assert_eq!(ran(true, Some("a/heavy")), vec!["a/heavy".to_owned()]);
 }
 
 #[test]
