@@ -3,9 +3,13 @@
 //! (`Count(100000000)` used to abort with "memory allocation of 43200000000 bytes failed").
 //!
 //! The per-item costs are measurements (README "Output cost"), rounded up:
-//! - memory: [`BYTES_PER_GRAIN`] per placed grain (10,000 Ottawa clones at 0.52: peak RSS
-//!   517 MB, i.e. 52 KB per grain, all stages) plus [`BYTES_PER_SHAPE`] per distinct shape
-//!   (the clone's mesh radii, DNA and star table) and one chunk of level sets;
+//! - memory: [`BYTES_PER_GRAIN`] per placed grain plus [`BYTES_PER_SHAPE`] per distinct
+//!   shape (the clone's mesh radii, DNA) and one chunk of level sets: 55 KB per grain of
+//!   its own shape, the measured slope (peak RSS of `examples/specimen-dense.ron` at 0.60:
+//!   595 MB at 10,000 clones, 2.67 GB at 50,000, 5.22 GB at 100,000, i.e. 51 KB per grain
+//!   added) with a little to spare: the former 100 KB per grain (60 + 40, from the 10,000-
+//!   grain total) refused 100,000 clones on a machine with 6–10 GB free, where they need
+//!   5.2 GB;
 //! - disk: an LS-DEM morph file holds `≈ (level_set_resolution + 4)³` level-set values
 //!   (the median grain at the common spacing, larger grains more: × [`MORPH_SPREAD`]) of
 //!   [`BYTES_PER_VALUE`] each, plus its nodes; a VTU surface 44 KB per grain at 16 cells
@@ -18,10 +22,11 @@ use anyhow::bail;
 
 use super::scene::Scene;
 
-/// Memory per placed grain (star table, packer state, pose, check nodes), bytes.
-pub(crate) const BYTES_PER_GRAIN: f64 = 60e3;
-/// Memory per distinct shape (the clone: mesh radii, DNA, star table), bytes.
-pub(crate) const BYTES_PER_SHAPE: f64 = 40e3;
+/// Memory per placed grain (star table, proxy spheres and neighbour lists, gap nodes,
+/// pose, check nodes), bytes.
+pub(crate) const BYTES_PER_GRAIN: f64 = 45e3;
+/// Memory per distinct shape (the clone: mesh radii, DNA), bytes.
+pub(crate) const BYTES_PER_SHAPE: f64 = 10e3;
 /// Bytes per level-set value in a morph file (shortest round-trip float and a space).
 pub(crate) const BYTES_PER_VALUE: f64 = 20.0;
 /// Mean morph file size over the median grain's (larger grains have larger grids at the
@@ -69,7 +74,7 @@ impl Estimate {
             && self.memory > m
         {
             bail!(
-                "the scene needs about {} of memory by its estimate (60 KB per grain, 40 KB per distinct shape: measured 517 MB at 10,000 grains), more than the {} available: lower `clones` (or set `distinct_shapes`)",
+                "the scene needs about {} of memory by its estimate (45 KB per grain, 10 KB per distinct shape: measured 5.22 GB peak at 100,000 clones), more than the {} available: lower `clones` (or set `distinct_shapes`)",
                 human(self.memory),
                 human(m)
             );
@@ -149,9 +154,12 @@ mod tests {
             .expect_err("refused")
             .to_string();
         assert!(msg.contains("memory") && msg.contains("TB"), "{msg}");
-        // 10,000 grains fit a 24 GB machine
+        // 10,000 grains fit a 24 GB machine; 100,000 (measured peak 5.22 GB) a 6 GB one
         let s = scene("Scene(clones: Count(10000), container: AutoCylinder(solid_fraction: 0.5))");
         assert!(Estimate::of(&s).check(Some(24e9), Some(77e9)).is_ok());
+        let s = scene("Scene(clones: Count(100000), container: AutoCylinder(solid_fraction: 0.6))");
+        let e = Estimate::of(&s);
+        assert!(e.memory > 5.22e9 && e.memory < 6e9, "{e:?}");
     }
 
     #[test]
