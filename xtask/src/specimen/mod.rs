@@ -31,6 +31,7 @@ use rayon::prelude::*;
 pub(crate) mod check;
 mod dem;
 mod estimate;
+#[cfg(test)]
 mod golden;
 mod outputs;
 mod place;
