@@ -501,16 +501,9 @@ fn neighbours(
             v
         })
         .collect();
+    // a grain meets another through one image at most: the grain orders
     for v in &mut out {
-        v.sort_unstable_by(|a, b| {
-            a.0.cmp(&b.0).then_with(|| {
-                a.1.iter()
-                    .zip(b.1.iter())
-                    .fold(std::cmp::Ordering::Equal, |o, (x, y)| {
-                        o.then(x.total_cmp(y))
-                    })
-            })
-        });
+        v.sort_unstable_by_key(|e| e.0);
     }
     out
 }

@@ -464,12 +464,10 @@ impl System<'_> {
                             let gb =
                                 proxy.groups[j * CLUSTERS + b]..proxy.groups[j * CLUSTERS + b + 1];
                             for s in ga {
+                                // sphere s moved by the image's inverse shift
+                                let p = [x[s][0] - sh.x, x[s][1] - sh.y, x[s][2] - sh.z];
                                 for t in gb.clone() {
-                                    let d = [
-                                        x[s][0] - x[t][0] - sh.x,
-                                        x[s][1] - x[t][1] - sh.y,
-                                        x[s][2] - x[t][2] - sh.z,
-                                    ];
+                                    let d = [p[0] - x[t][0], p[1] - x[t][1], p[2] - x[t][2]];
                                     let cut = x[s][3] + x[t][3] + skin;
                                     if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut {
                                         pairs.push((s as u32, t as u32 | tag));
@@ -523,12 +521,18 @@ impl System<'_> {
                     let mut acc = [0.0; 3];
                     for &e in &list[start[i] as usize..start[i + 1] as usize] {
                         let b = &x[(e & INDEX_MASK) as usize];
-                        let sh = &shifts[(e >> INDEX_BITS) as usize];
-                        let d = [
-                            a[0] - b[0] - sh[0],
-                            a[1] - b[1] - sh[1],
-                            a[2] - b[2] - sh[2],
-                        ];
+                        // a pair within the cell (always, without periodic
+                        // axes) skips the image's shift
+                        let d = if e <= INDEX_MASK {
+                            [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+                        } else {
+                            let sh = &shifts[(e >> INDEX_BITS) as usize];
+                            [
+                                a[0] - b[0] - sh[0],
+                                a[1] - b[1] - sh[1],
+                                a[2] - b[2] - sh[2],
+                            ]
+                        };
                         let dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                         let cut = a[3] + b[3];
                         if dd >= cut * cut {
