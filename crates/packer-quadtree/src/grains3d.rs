@@ -532,24 +532,11 @@ fn check_input(grains: &[StarGrain], boundary: &Boundary) -> Result<f64> {
 }
 
 /// Validates a boundary for grains of bounding diameter up to `largest`:
-/// the container holds the largest grain, and every periodic side is at
-/// least `3 · largest` (so that a pair meets through one image only).
+/// its geometry, the container holds the largest grain, and the periodic
+/// sides are long enough ([`check_periodic_sides`]).
 fn check_boundary(boundary: &Boundary, largest: f64) -> Result<()> {
-    let container = match boundary {
-        Boundary::Periodic { min, max } => {
-            for k in 0..3 {
-                finite("periodic cell min", min[k])?;
-                finite("periodic cell max", max[k])?;
-                positive("periodic cell side (max - min)", max[k] - min[k])?;
-            }
-            None
-        }
-        Boundary::Walls(c) => {
-            c.validate()?;
-            Some(c)
-        }
-    };
-    if let Some(c) = container {
+    validate_boundary(boundary)?;
+    if let Boundary::Walls(c) = boundary {
         let inscribed = c.inscribed_diameter();
         if inscribed < largest {
             return Err(Error::DomainTooSmall {
@@ -558,6 +545,28 @@ fn check_boundary(boundary: &Boundary, largest: f64) -> Result<()> {
             });
         }
     }
+    check_periodic_sides(boundary, largest)
+}
+
+/// Checks a boundary's geometry: finite corners and positive sides (a
+/// periodic cell), or the container's own validation.
+fn validate_boundary(boundary: &Boundary) -> Result<()> {
+    match boundary {
+        Boundary::Periodic { min, max } => {
+            for k in 0..3 {
+                finite("periodic cell min", min[k])?;
+                finite("periodic cell max", max[k])?;
+                positive("periodic cell side (max - min)", max[k] - min[k])?;
+            }
+            Ok(())
+        }
+        Boundary::Walls(c) => c.validate(),
+    }
+}
+
+/// Every periodic side is at least `3 · largest` (so that a pair of grains
+/// of bounding diameter up to `largest` meets through one image only).
+fn check_periodic_sides(boundary: &Boundary, largest: f64) -> Result<()> {
     let region = Region::new(boundary);
     for k in 0..3 {
         if region.period()[k] && region.side(k) < 3.0 * largest {
@@ -955,16 +964,7 @@ pub fn occupied_in(
     boundary: &Boundary,
     points: &[Point3<f64>],
 ) -> Result<Vec<bool>> {
-    match boundary {
-        Boundary::Periodic { min, max } => {
-            for k in 0..3 {
-                finite("periodic cell min", min[k])?;
-                finite("periodic cell max", max[k])?;
-                positive("periodic cell side (max - min)", max[k] - min[k])?;
-            }
-        }
-        Boundary::Walls(c) => c.validate()?,
-    }
+    validate_boundary(boundary)?;
     occupied_impl(grains, poses, Some(&Region::new(boundary)), points)
 }
 

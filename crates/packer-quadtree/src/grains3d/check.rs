@@ -22,12 +22,14 @@
 //! Periodic cells ([`check_grain_overlaps_in`]): the centres are wrapped
 //! into the cell and every grain within two bounding radii of a periodic
 //! face is copied as an image beyond the opposite face (its own copies,
-//! not the packer's); a pair meeting through an image is checked with the
+//! not the packer's neighbour lists; wrapping and wall clearance are the
+//! shared `Region`'s); a pair meeting through an image is checked with the
 //! image's position, and counted in [`GrainOverlapReport::periodic_pairs`].
 
 use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use rayon::prelude::*;
 
+use super::region::Region;
 use super::{StarGrain, fibonacci};
 use crate::error::{Error, Result, finite, positive};
 use crate::pack3d::{Boundary, Container};
@@ -146,21 +148,12 @@ pub fn check_grain_overlaps_in(
     if grains.is_empty() {
         return Err(Error::Empty { what: "grain list" });
     }
+    // (a grain the container cannot hold is not refused: its nodes outside
+    // the walls are what the report counts)
     let largest = grains.iter().map(|g| 2.0 * g.r_max()).fold(0.0, f64::max);
-    super::check_boundary(boundary, largest).or_else(|e| match e {
-        // a packing may hold grains the container cannot: reported by nodes outside
-        Error::DomainTooSmall { particle, .. } if particle == largest => Ok(()),
-        e => Err(e),
-    })?;
-    let (container, cell) = match boundary {
-        Boundary::Walls(c) => {
-            let (lo, hi) = c.bbox();
-            let [px, py] = c.periodic();
-            (Some(c), (lo.coords, hi.coords, [px, py, false]))
-        }
-        Boundary::Periodic { min, max } => (None, (min.coords, max.coords, [true; 3])),
-    };
-    let clearance = |p: &Point3<f64>| container.map_or(f64::INFINITY, |c| c.clearance(p));
+    super::validate_boundary(boundary)?;
+    super::check_periodic_sides(boundary, largest)?;
+    let region = Region::new(boundary);
     if poses.len() != grains.len() {
         return Err(Error::Parameter {
             what: "pose count",
@@ -195,10 +188,10 @@ pub fn check_grain_overlaps_in(
         .collect();
     let cs: Vec<Vector3<f64>> = poses
         .iter()
-        .map(|p| wrap(p.translation.vector, &cell))
+        .map(|p| region.wrap(&p.translation.vector))
         .collect();
     let d_eq: Vec<f64> = grains.iter().map(StarGrain::equivalent_diameter).collect();
-    let nbrs = neighbours(grains, &cs, &cell);
+    let nbrs = neighbours(grains, &cs, &region);
     let pairs = nbrs.iter().map(Vec::len).sum::<usize>() / 2;
     let periodic_pairs = nbrs
         .iter()
@@ -252,7 +245,7 @@ pub fn check_grain_overlaps_in(
                 }
                 let p = u * t;
                 resid = resid.max(phi.abs() / d_eq[i]);
-                let cl = clearance(&Point3::from(rots[i] * p + cs[i])) / d_eq[i];
+                let cl = region.clearance(&Point3::from(rots[i] * p + cs[i])) / d_eq[i];
                 wall = wall.min(cl);
                 if cl < -params.tolerance {
                     outside += 1;
@@ -420,23 +413,6 @@ pub fn check_grain_overlaps_in(
     Ok(report)
 }
 
-/// The periodic cell `(lo, hi, periodic axes)` of a check.
-type Cell = (Vector3<f64>, Vector3<f64>, [bool; 3]);
-
-/// `p` moved by whole sides into `[lo, hi)` on the periodic axes.
-fn wrap(mut p: Vector3<f64>, cell: &Cell) -> Vector3<f64> {
-    for k in 0..3 {
-        if cell.2[k] {
-            let l = cell.1[k] - cell.0[k];
-            p[k] -= l * ((p[k] - cell.0[k]) / l).floor();
-            if p[k] >= cell.1[k] {
-                p[k] = cell.0[k];
-            }
-        }
-    }
-    p
-}
-
 /// For every grain, the grains whose bounding spheres meet its own (both
 /// directions), each with the shift of the image it meets through (zero
 /// within the cell), by a sweep over the centres and their images sorted
@@ -444,8 +420,9 @@ fn wrap(mut p: Vector3<f64>, cell: &Cell) -> Vector3<f64> {
 fn neighbours(
     grains: &[StarGrain],
     cs: &[Vector3<f64>],
-    cell: &Cell,
+    region: &Region<'_>,
 ) -> Vec<Vec<(usize, Vector3<f64>)>> {
+    let ((lo, hi), period) = (region.bbox(), region.period());
     let n = grains.len();
     let r_all = grains.iter().map(StarGrain::r_max).fold(0.0_f64, f64::max);
     // images: every combination of shifts by ± a side towards the faces a
@@ -454,13 +431,13 @@ fn neighbours(
     for (i, c) in cs.iter().enumerate() {
         let mut options: Vec<Vector3<f64>> = vec![Vector3::zeros()];
         for k in 0..3 {
-            if !cell.2[k] {
+            if !period[k] {
                 continue;
             }
-            let l = cell.1[k] - cell.0[k];
-            let s = if c[k] - cell.0[k] < 2.0 * r_all {
+            let l = hi[k] - lo[k];
+            let s = if c[k] - lo[k] < 2.0 * r_all {
                 l
-            } else if cell.1[k] - c[k] < 2.0 * r_all {
+            } else if hi[k] - c[k] < 2.0 * r_all {
                 -l
             } else {
                 continue;
