@@ -696,7 +696,7 @@ pub fn pack_grains_in(
     let poses = centres
         .iter()
         .zip(&rotations)
-        .map(|(c, q)| Isometry3::from_parts(Translation3::from(region.wrap(c)), *q))
+        .map(|(c, q)| Isometry3::from_parts(Translation3::from(*c), *q))
         .collect();
     Ok(GrainPacking { poses, stats })
 }

@@ -605,8 +605,11 @@ pub(super) fn relax(
     )?;
     stats.fine_sweeps = sweeps - stats.coarse_sweeps;
     stats.growth_start = lam0;
-    for c in &mut centres {
-        *c = region.wrap(c);
+    // the poses handed out are wrapped into a periodic cell
+    if region.is_periodic() {
+        for c in &mut centres {
+            *c = region.wrap(c);
+        }
     }
     let near = Near::new(&frame, region, &centres);
     let fin: Vec<(f64, usize, f64)> = (0..n)
