@@ -16,7 +16,8 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use levelset::Orientation;
 use nalgebra::Point3;
-use packer_quadtree::{Boundary, Container, DensifyParams, Grading, Pack3Params, Sphere, Target};
+use packer_quadtree::Grading;
+use packer_spheres::{Boundary, Container, DensifyParams, Pack3Params, Sphere, Target};
 
 use crate::pack_cmd::{Output, Preset};
 use crate::progress::write_atomic;
@@ -165,7 +166,7 @@ impl Run3<'_> {
         }
         let t_setup = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        let p = packer_quadtree::pack3d_seeded(&container, &self.grading, &params, self.seed)?;
+        let p = packer_spheres::pack3d_seeded(&container, &self.grading, &params, self.seed)?;
         let t_pack = t1.elapsed().as_secs_f64();
         let t2 = Instant::now();
         let report = metrics_report(&container, &self.grading, &p.spheres)?;
@@ -223,7 +224,7 @@ impl Run3<'_> {
             target,
             ..DensifyParams::default()
         };
-        let p = packer_quadtree::pack3d_dense(
+        let p = packer_spheres::pack3d_dense(
             &boundary,
             &self.grading,
             &self.params(),
@@ -239,14 +240,14 @@ impl Run3<'_> {
                 false,
             ),
             Boundary::Periodic { min, max } => {
-                let worst = packer_quadtree::max_overlap(&p.spheres, &p.boundary)?;
+                let worst = packer_spheres::max_overlap(&p.spheres, &p.boundary)?;
                 if worst > 1e-9 {
                     bail!(
                         "the independent check rejects this packing (worst overlap / d {worst:.2e}): \
                          nothing written; please report it with the command line"
                     );
                 }
-                let g = packer_quadtree::grading_report(&self.grading, &p.spheres)?;
+                let g = packer_spheres::grading_report(&self.grading, &p.spheres)?;
                 let mut t = String::new();
                 let _ = writeln!(
                     t,
@@ -271,7 +272,6 @@ impl Run3<'_> {
                 };
                 (t, c, true)
             }
-            other => bail!("unsupported densification domain {other:?}"),
         };
         let t_check = t2.elapsed().as_secs_f64();
         let t_write = self.write(root, &p.spheres, &container, fully)?;
@@ -340,17 +340,17 @@ impl Run3<'_> {
             let (name, bytes) = match f {
                 Output::Csv => {
                     let mut b = Vec::new();
-                    packer_quadtree::write_csv3(spheres, &mut b)?;
+                    packer_spheres::write_csv3(spheres, &mut b)?;
                     ("packing.csv", b)
                 }
                 Output::Vtu => {
                     let mut b = Vec::new();
-                    packer_quadtree::write_vtu3(spheres, &mut b)?;
+                    packer_spheres::write_vtu3(spheres, &mut b)?;
                     ("packing.vtu", b)
                 }
                 Output::Lammps => {
                     let mut b = Vec::new();
-                    packer_quadtree::write_lammps_data3(spheres, container, self.density, &mut b)?;
+                    packer_spheres::write_lammps_data3(spheres, container, self.density, &mut b)?;
                     if fully {
                         // the box is periodic in z too: the title line names the boundary
                         let text = String::from_utf8(b)?;
@@ -365,7 +365,7 @@ impl Run3<'_> {
                 }
                 Output::Yade => {
                     let mut b = Vec::new();
-                    packer_quadtree::write_yade3(spheres, &mut b)?;
+                    packer_spheres::write_yade3(spheres, &mut b)?;
                     ("packing.txt", b)
                 }
                 Output::Svg => continue,
@@ -385,7 +385,7 @@ fn metrics_report(
 ) -> anyhow::Result<String> {
     let mut text = String::new();
     let d_max = grading.d_max();
-    let check = packer_quadtree::check_spheres(container, spheres, 1e-9)?;
+    let check = packer_spheres::check_spheres(container, spheres, 1e-9)?;
     if !check.is_clean(1e-9) {
         bail!(
             "the independent checker rejects this packing (worst pair gap / d {:.2e}, worst wall \
@@ -394,7 +394,7 @@ fn metrics_report(
             check.worst_normalised_wall_gap
         );
     }
-    let overall = packer_quadtree::solid_fraction(container, spheres)?;
+    let overall = packer_spheres::solid_fraction(container, spheres)?;
     let _ = writeln!(
         text,
         "{} spheres, solid fraction {overall:.4} overall; mean coordination number {:.2}; worst \
@@ -404,7 +404,7 @@ fn metrics_report(
         check.worst_normalised_gap,
         check.worst_normalised_wall_gap
     );
-    match packer_quadtree::core_solid_fraction(container, spheres, 2.0 * d_max) {
+    match packer_spheres::core_solid_fraction(container, spheres, 2.0 * d_max) {
         Ok(core) => {
             let _ = writeln!(
                 text,
@@ -419,7 +419,7 @@ fn metrics_report(
     }
     if let Container::Cylinder { radius, .. } = container {
         let bins = ((radius / (0.5 * d_max)).round() as usize).clamp(4, 200);
-        let prof = packer_quadtree::radial_profile(container, spheres, bins)?;
+        let prof = packer_spheres::radial_profile(container, spheres, bins)?;
         let _ = writeln!(text, "radial solid fraction profile (annulus: fraction):");
         for b in prof {
             let _ = writeln!(
@@ -429,7 +429,7 @@ fn metrics_report(
             );
         }
     }
-    let g = packer_quadtree::grading_report(grading, spheres)?;
+    let g = packer_spheres::grading_report(grading, spheres)?;
     let _ = writeln!(
         text,
         "grading by mass: Cu {:.3} (requested {:.3}), Cc {:.3} (requested {:.3}), max deviation of \
@@ -442,7 +442,7 @@ fn metrics_report(
 #[cfg(test)]
 mod tests {
     use super::{parse_boundary, parse_container, parse_target};
-    use packer_quadtree::{Boundary, Container, Target};
+    use packer_spheres::{Boundary, Container, Target};
     use std::path::Path;
 
     #[test]

@@ -13,10 +13,10 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use nalgebra::Point2;
+use packer_contact::{GrainShape, PicPacking, PicParams, check_pic, pack_pic, write_pic_vtu};
 use packer_quadtree::{
-    Domain, Grading, GrainShape, PackParams, PicPacking, PicParams, check_packing, check_pic,
-    pack_pic, pack_seeded, porosity, write_csv, write_lammps_data, write_pic_vtu, write_svg,
-    write_vtu, write_yade,
+    Domain, Grading, PackParams, check_packing, pack_seeded, porosity, write_csv,
+    write_lammps_data, write_svg, write_vtu, write_yade,
 };
 
 /// Parameter presets of the packer.

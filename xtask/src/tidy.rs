@@ -16,7 +16,19 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("morph-dna", &["levelset", "sph-harmonics"]),
     // layer 2
     ("cloner", &["morph-dna", "levelset", "sph-harmonics"]),
-    ("packer-quadtree", &["levelset"]),
+    // the packers: seed 004's 2D front (with the gradings every packer
+    // uses) and seed 001's particle-in-contact solvers at the bottom, the 3D
+    // sphere front on both, the grain packer on the sphere front
+    ("packer-quadtree", &[]),
+    ("packer-contact", &[]),
+    (
+        "packer-spheres",
+        &["packer-quadtree", "packer-contact", "levelset"],
+    ),
+    (
+        "packer-grains",
+        &["packer-spheres", "packer-quadtree", "levelset"],
+    ),
     // layer 3
     (
         "validate",
@@ -26,6 +38,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "morph-dna",
             "cloner",
             "packer-quadtree",
+            "packer-contact",
+            "packer-spheres",
+            "packer-grains",
         ],
     ),
     // layer 4
@@ -37,6 +52,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "morph-dna",
             "cloner",
             "packer-quadtree",
+            "packer-contact",
+            "packer-spheres",
+            "packer-grains",
             "validate",
         ],
     ),
@@ -49,6 +67,9 @@ const LIBRARIES: &[&str] = &[
     "morph-dna",
     "cloner",
     "packer-quadtree",
+    "packer-contact",
+    "packer-spheres",
+    "packer-grains",
     "validate",
 ];
 
@@ -392,4 +413,65 @@ fn readme_test_command_is_what_ci_runs() {
         ci.contains(command),
         ".ci/run must run the README's test command `{command}`"
     );
+}
+
+mod lengths;
+
+/// Non-test source files of every crate (`src/` of the libraries and xtask).
+fn source_files() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for name in workspace_crates() {
+        rust_files(&crate_dir(&name).join("src"), &mut files);
+    }
+    files.retain(|f| !lengths::is_test_file(f.strip_prefix(root()).unwrap_or(f)));
+    files.sort();
+    files
+}
+
+#[test]
+fn no_long_functions_or_files() {
+    let mut long = Vec::new();
+    for file in source_files() {
+        let rel = file
+            .strip_prefix(root())
+            .unwrap_or(&file)
+            .display()
+            .to_string();
+        let (fns, lines) = lengths::measure(&read(&file));
+        if lines > lengths::MAX_FILE_LINES {
+            long.push(format!(
+                "{rel}: {lines} non-test lines (limit {})",
+                lengths::MAX_FILE_LINES
+            ));
+        }
+        for f in fns.iter().filter(|f| f.lines > lengths::MAX_FN_LINES) {
+            long.push(format!(
+                "{rel}:{}: fn {} is {} lines (limit {})",
+                f.line,
+                f.name,
+                f.lines,
+                lengths::MAX_FN_LINES
+            ));
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "split these along their stages or concepts (house style, \"Library first\"):\n{}",
+        long.join("\n")
+    );
+}
+
+#[test]
+fn lengths_skip_comments_strings_and_tests() {
+    let src = "//! doc\nfn short() {\n    let s = \"}}}\";\n    let c = '}';\n    let r = r#\"{\"#;\n    // }\n    /* { /* } */ */\n}\nfn lifetime<'a>(x: &'a str) -> &'a str {\n    x\n}\ntrait T {\n    fn decl(&self);\n}\n#[cfg(test)]\nmod tests {\n    fn in_test() {\n    }\n}\n";
+    let (fns, lines) = lengths::measure(src);
+    let got: Vec<(&str, usize, usize)> = fns
+        .iter()
+        .map(|f| (f.name.as_str(), f.line, f.lines))
+        .collect();
+    assert_eq!(got, vec![("short", 2, 7), ("lifetime", 9, 3)]);
+    assert_eq!(lines, 14);
+    let long = format!("fn big() {{\n{}}}\n", "    x();\n".repeat(200));
+    let (fns, _) = lengths::measure(&long);
+    assert_eq!(fns[0].lines, 202);
 }

@@ -303,177 +303,31 @@ impl TriMesh {
     /// As listed above; [`Error::EmptyMesh`] if no triangle survives step 2.
     pub fn prepare_closed(&self, policy: Orientation) -> Result<(TriMesh, MeshRepair)> {
         let v = &self.vertices;
-        let pos = |i: usize| [v[i].x, v[i].y, v[i].z];
         let mut repair = MeshRepair::default();
 
         // 1. Weld: sort by position (then index), map every vertex to the first of its group.
-        let key = |p: &Point3<f64>| {
-            [
-                (p.x + 0.0).to_bits(),
-                (p.y + 0.0).to_bits(),
-                (p.z + 0.0).to_bits(),
-            ]
-        };
-        let mut order: Vec<usize> = (0..v.len()).collect();
-        order.sort_unstable_by_key(|&i| (key(&v[i]), i));
-        let mut rep: Vec<usize> = (0..v.len()).collect();
-        for w in order.windows(2) {
-            if key(&v[w[0]]) == key(&v[w[1]]) {
-                rep[w[1]] = rep[w[0]];
-                repair.welded += 1;
-            }
-        }
+        let (rep, welded) = weld(v);
+        repair.welded = welded;
 
         // 2. Degenerate triangles.
-        let mut tris: Vec<[usize; 3]> = Vec::with_capacity(self.triangles.len());
-        let mut source: Vec<usize> = Vec::with_capacity(self.triangles.len());
-        for (t, tri) in self.triangles.iter().enumerate() {
-            let [a, b, c] = tri.map(|i| rep[i]);
-            if degenerate(v, a, b, c) {
-                repair.degenerate_removed += 1;
-            } else {
-                tris.push([a, b, c]);
-                source.push(t);
-            }
-        }
+        let (tris, source, removed) = without_degenerate(v, &self.triangles, &rep);
+        repair.degenerate_removed = removed;
         if tris.is_empty() {
             return Err(Error::EmptyMesh);
         }
         let n = tris.len();
 
-        // 3. Edges: half-edge h = 3t + e runs from tris[t][e] to tris[t][(e + 1) % 3].
-        let start = |h: usize| tris[h / 3][h % 3];
-        let mut edges: Vec<(usize, usize, usize)> = Vec::with_capacity(3 * n);
-        for (t, tri) in tris.iter().enumerate() {
-            for e in 0..3 {
-                let (a, b) = (tri[e], tri[(e + 1) % 3]);
-                edges.push((a.min(b), a.max(b), 3 * t + e));
-            }
-        }
-        edges.sort_unstable();
-        let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(3 * n / 2);
-        let mut non_manifold: Option<(usize, usize, usize)> = None;
-        let mut non_manifold_edges = 0;
-        let mut boundary: Option<(usize, usize)> = None;
-        let mut boundary_edges = 0;
-        for group in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-            let (a, b, h) = group[0];
-            match group {
-                [_] => {
-                    boundary_edges += 1;
-                    boundary.get_or_insert((a, b));
-                }
-                [_, (_, _, g)] => pairs.push((h, *g)),
-                _ => {
-                    non_manifold_edges += 1;
-                    non_manifold.get_or_insert((a, b, group.len()));
-                }
-            }
-        }
-        if let Some((a, b, count)) = non_manifold {
-            return Err(Error::NonManifoldEdge {
-                a,
-                b,
-                pa: pos(a),
-                pb: pos(b),
-                count,
-                edges: non_manifold_edges,
-            });
-        }
-        if let Some((a, b)) = boundary {
-            return Err(Error::OpenMesh {
-                a,
-                b,
-                pa: pos(a),
-                pb: pos(b),
-                boundary_edges,
-            });
-        }
+        // 3. Edges: every undirected edge in exactly two triangles.
+        let pairs = pair_edges(v, &tris)?;
 
-        // 4. Vertex fans: corners (3t + i, at tris[t][i]) joined across shared edges; a
-        // manifold vertex has all its corners in one class.
-        let mut corners = UnionFind::new(3 * n);
-        let mut triangles_uf = UnionFind::new(n);
-        // Per half-edge: the triangle across it and whether both run the same way.
-        let mut across = vec![(0usize, false); 3 * n];
-        for &(h, g) in &pairs {
-            let next = |x: usize| 3 * (x / 3) + (x % 3 + 1) % 3;
-            let same = start(h) == start(g);
-            if same {
-                corners.union(h, g);
-                corners.union(next(h), next(g));
-            } else {
-                corners.union(h, next(g));
-                corners.union(next(h), g);
-            }
-            triangles_uf.union(h / 3, g / 3);
-            across[h] = (g / 3, same);
-            across[g] = (h / 3, same);
-        }
-        let mut fans: Vec<(usize, usize)> =
-            (0..3 * n).map(|c| (start(c), corners.find(c))).collect();
-        fans.sort_unstable();
-        fans.dedup();
-        for group in fans.chunk_by(|x, y| x.0 == y.0) {
-            if group.len() > 1 {
-                let vertex = group[0].0;
-                return Err(Error::NonManifoldVertex {
-                    vertex,
-                    position: pos(vertex),
-                    fans: group.len(),
-                });
-            }
-        }
-
-        // 5. One component.
-        let count = (0..n).filter(|&t| triangles_uf.find(t) == t).count();
-        if count > 1 {
-            return Err(Error::SeveralComponents { count });
-        }
+        // 4. Vertex fans and 5. one component.
+        let across = fans_and_component(v, &tris, &pairs)?;
 
         // 6. Orientation classes by breadth-first search from triangle 0.
-        let mut flip: Vec<Option<bool>> = vec![None; n];
-        flip[0] = Some(false);
-        let mut queue = std::collections::VecDeque::from([0usize]);
-        while let Some(t) = queue.pop_front() {
-            let ft = flip[t].unwrap_or(false);
-            for &(u, same) in &across[3 * t..3 * t + 3] {
-                let want = ft ^ same;
-                match flip[u] {
-                    None => {
-                        flip[u] = Some(want);
-                        queue.push_back(u);
-                    }
-                    Some(f) if f != want => {
-                        return Err(Error::NonOrientable {
-                            triangle: source[u],
-                        });
-                    }
-                    Some(_) => {}
-                }
-            }
-        }
-        let mut flip: Vec<bool> = flip.into_iter().map(|f| f.unwrap_or(false)).collect();
-        let mut flipped = flip.iter().filter(|&&f| f).count();
-        if 2 * flipped > n {
-            flip.iter_mut().for_each(|f| *f = !*f);
-            flipped = n - flipped;
-        }
+        let (flip, flipped) = orientation_classes(&across, &source)?;
 
         // 7. Volume of the consistent mesh.
-        let o = self.box_centre();
-        let mut six_v = 0.0;
-        let mut area = 0.0;
-        for (tri, &f) in tris.iter().zip(&flip) {
-            let (pa, pb, pc) = (v[tri[0]] - o, v[tri[1]] - o, v[tri[2]] - o);
-            let w = pa.dot(&pb.cross(&pc));
-            six_v += if f { -w } else { w };
-            area += 0.5 * (pb - pa).cross(&(pc - pa)).norm();
-        }
-        let volume = six_v / 6.0;
-        if !has_volume(volume, area) {
-            return Err(Error::ZeroVolume { volume, area });
-        }
+        let volume = consistent_volume(v, self.box_centre(), &tris, &flip)?;
         let inverted = volume < 0.0;
         if policy == Orientation::Refuse {
             if flipped > 0 {
@@ -490,30 +344,270 @@ impl TriMesh {
         repair.inverted = inverted;
 
         // Output: referenced vertices in their original order.
-        let mut index = vec![usize::MAX; v.len()];
-        for tri in &tris {
-            for &i in tri {
-                index[i] = 0;
-            }
-        }
-        let mut vertices = Vec::new();
-        for (i, slot) in index.iter_mut().enumerate() {
-            if *slot == 0 {
-                *slot = vertices.len();
-                vertices.push(v[i]);
-            }
-        }
+        let (vertices, triangles) = renumbered(v, &tris, &flip, inverted);
         repair.unreferenced = v.len() - repair.welded - vertices.len();
-        let triangles = tris
-            .iter()
-            .zip(&flip)
-            .map(|(tri, &f)| {
-                let [a, b, c] = tri.map(|i| index[i]);
-                if f ^ inverted { [a, c, b] } else { [a, b, c] }
-            })
-            .collect();
         Ok((Self::from_parts_unchecked(vertices, triangles), repair))
     }
+}
+
+/// The coordinates of vertex `i`, as the errors report them.
+fn position(v: &[Point3<f64>], i: usize) -> [f64; 3] {
+    [v[i].x, v[i].y, v[i].z]
+}
+
+/// Step 1 of [`TriMesh::prepare_closed`]: sorts the vertices by position (then index) and
+/// maps every vertex to the first of its group of bit-identical positions (−0 = +0).
+/// Returns the representative of every vertex and the number of vertices welded.
+fn weld(v: &[Point3<f64>]) -> (Vec<usize>, usize) {
+    let key = |p: &Point3<f64>| {
+        [
+            (p.x + 0.0).to_bits(),
+            (p.y + 0.0).to_bits(),
+            (p.z + 0.0).to_bits(),
+        ]
+    };
+    let mut welded = 0;
+    let mut order: Vec<usize> = (0..v.len()).collect();
+    order.sort_unstable_by_key(|&i| (key(&v[i]), i));
+    let mut rep: Vec<usize> = (0..v.len()).collect();
+    for w in order.windows(2) {
+        if key(&v[w[0]]) == key(&v[w[1]]) {
+            rep[w[1]] = rep[w[0]];
+            welded += 1;
+        }
+    }
+    (rep, welded)
+}
+
+/// Step 2 of [`TriMesh::prepare_closed`]: the triangles over the welded vertices `rep`
+/// without the degenerate ones, the input index of each, and the number removed.
+fn without_degenerate(
+    v: &[Point3<f64>],
+    triangles: &[[usize; 3]],
+    rep: &[usize],
+) -> (Vec<[usize; 3]>, Vec<usize>, usize) {
+    let mut removed = 0;
+    let mut tris: Vec<[usize; 3]> = Vec::with_capacity(triangles.len());
+    let mut source: Vec<usize> = Vec::with_capacity(triangles.len());
+    for (t, tri) in triangles.iter().enumerate() {
+        let [a, b, c] = tri.map(|i| rep[i]);
+        if degenerate(v, a, b, c) {
+            removed += 1;
+        } else {
+            tris.push([a, b, c]);
+            source.push(t);
+        }
+    }
+    (tris, source, removed)
+}
+
+/// Step 3 of [`TriMesh::prepare_closed`]: the pairs of half-edges (h = 3t + e runs from
+/// `tris[t][e]` to `tris[t][(e + 1) % 3]`) that share an undirected edge, in edge order.
+///
+/// # Errors
+/// [`Error::NonManifoldEdge`] for an edge of more than two triangles, else
+/// [`Error::OpenMesh`] for an edge of one (the lowest such edge and the counts).
+fn pair_edges(v: &[Point3<f64>], tris: &[[usize; 3]]) -> Result<Vec<(usize, usize)>> {
+    let n = tris.len();
+    let mut edges: Vec<(usize, usize, usize)> = Vec::with_capacity(3 * n);
+    for (t, tri) in tris.iter().enumerate() {
+        for e in 0..3 {
+            let (a, b) = (tri[e], tri[(e + 1) % 3]);
+            edges.push((a.min(b), a.max(b), 3 * t + e));
+        }
+    }
+    edges.sort_unstable();
+    let mut pairs: Vec<(usize, usize)> = Vec::with_capacity(3 * n / 2);
+    let mut non_manifold: Option<(usize, usize, usize)> = None;
+    let mut non_manifold_edges = 0;
+    let mut boundary: Option<(usize, usize)> = None;
+    let mut boundary_edges = 0;
+    for group in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        let (a, b, h) = group[0];
+        match group {
+            [_] => {
+                boundary_edges += 1;
+                boundary.get_or_insert((a, b));
+            }
+            [_, (_, _, g)] => pairs.push((h, *g)),
+            _ => {
+                non_manifold_edges += 1;
+                non_manifold.get_or_insert((a, b, group.len()));
+            }
+        }
+    }
+    if let Some((a, b, count)) = non_manifold {
+        return Err(Error::NonManifoldEdge {
+            a,
+            b,
+            pa: position(v, a),
+            pb: position(v, b),
+            count,
+            edges: non_manifold_edges,
+        });
+    }
+    if let Some((a, b)) = boundary {
+        return Err(Error::OpenMesh {
+            a,
+            b,
+            pa: position(v, a),
+            pb: position(v, b),
+            boundary_edges,
+        });
+    }
+    Ok(pairs)
+}
+
+/// Steps 4 and 5 of [`TriMesh::prepare_closed`]: vertex fans, corners (3t + i, at
+/// `tris[t][i]`) joined across shared edges (a manifold vertex has all its corners in one
+/// class), and edge-connected components. Returns per half-edge the triangle across it and
+/// whether both run the same way.
+///
+/// # Errors
+/// [`Error::NonManifoldVertex`], [`Error::SeveralComponents`].
+fn fans_and_component(
+    v: &[Point3<f64>],
+    tris: &[[usize; 3]],
+    pairs: &[(usize, usize)],
+) -> Result<Vec<(usize, bool)>> {
+    let n = tris.len();
+    let start = |h: usize| tris[h / 3][h % 3];
+    let mut corners = UnionFind::new(3 * n);
+    let mut triangles_uf = UnionFind::new(n);
+    // Per half-edge: the triangle across it and whether both run the same way.
+    let mut across = vec![(0usize, false); 3 * n];
+    for &(h, g) in pairs {
+        let next = |x: usize| 3 * (x / 3) + (x % 3 + 1) % 3;
+        let same = start(h) == start(g);
+        if same {
+            corners.union(h, g);
+            corners.union(next(h), next(g));
+        } else {
+            corners.union(h, next(g));
+            corners.union(next(h), g);
+        }
+        triangles_uf.union(h / 3, g / 3);
+        across[h] = (g / 3, same);
+        across[g] = (h / 3, same);
+    }
+    let mut fans: Vec<(usize, usize)> = (0..3 * n).map(|c| (start(c), corners.find(c))).collect();
+    fans.sort_unstable();
+    fans.dedup();
+    for group in fans.chunk_by(|x, y| x.0 == y.0) {
+        if group.len() > 1 {
+            let vertex = group[0].0;
+            return Err(Error::NonManifoldVertex {
+                vertex,
+                position: position(v, vertex),
+                fans: group.len(),
+            });
+        }
+    }
+
+    // 5. One component.
+    let count = (0..n).filter(|&t| triangles_uf.find(t) == t).count();
+    if count > 1 {
+        return Err(Error::SeveralComponents { count });
+    }
+    Ok(across)
+}
+
+/// Step 6 of [`TriMesh::prepare_closed`]: the orientation class of every triangle by
+/// breadth-first search from triangle 0 over `across` (see [`fans_and_component`]), the
+/// minority class (ties: that of triangle 0 wins) marked as flipped. Returns the marks and
+/// the number flipped.
+///
+/// # Errors
+/// [`Error::NonOrientable`] (with the input index from `source`) for a one-sided surface.
+fn orientation_classes(across: &[(usize, bool)], source: &[usize]) -> Result<(Vec<bool>, usize)> {
+    let n = source.len();
+    let mut flip: Vec<Option<bool>> = vec![None; n];
+    flip[0] = Some(false);
+    let mut queue = std::collections::VecDeque::from([0usize]);
+    while let Some(t) = queue.pop_front() {
+        let ft = flip[t].unwrap_or(false);
+        for &(u, same) in &across[3 * t..3 * t + 3] {
+            let want = ft ^ same;
+            match flip[u] {
+                None => {
+                    flip[u] = Some(want);
+                    queue.push_back(u);
+                }
+                Some(f) if f != want => {
+                    return Err(Error::NonOrientable {
+                        triangle: source[u],
+                    });
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    let mut flip: Vec<bool> = flip.into_iter().map(|f| f.unwrap_or(false)).collect();
+    let mut flipped = flip.iter().filter(|&&f| f).count();
+    if 2 * flipped > n {
+        flip.iter_mut().for_each(|f| *f = !*f);
+        flipped = n - flipped;
+    }
+    Ok((flip, flipped))
+}
+
+/// Step 7 of [`TriMesh::prepare_closed`]: the signed volume of the mesh with the `flip`ped
+/// triangles reversed (about `o`, the centre of the bounding box).
+///
+/// # Errors
+/// [`Error::ZeroVolume`] if the volume vanishes (see [`has_volume`]).
+fn consistent_volume(
+    v: &[Point3<f64>],
+    o: Point3<f64>,
+    tris: &[[usize; 3]],
+    flip: &[bool],
+) -> Result<f64> {
+    let mut six_v = 0.0;
+    let mut area = 0.0;
+    for (tri, &f) in tris.iter().zip(flip) {
+        let (pa, pb, pc) = (v[tri[0]] - o, v[tri[1]] - o, v[tri[2]] - o);
+        let w = pa.dot(&pb.cross(&pc));
+        six_v += if f { -w } else { w };
+        area += 0.5 * (pb - pa).cross(&(pc - pa)).norm();
+    }
+    let volume = six_v / 6.0;
+    if !has_volume(volume, area) {
+        return Err(Error::ZeroVolume { volume, area });
+    }
+    Ok(volume)
+}
+
+/// The output of [`TriMesh::prepare_closed`]: the referenced vertices in their original
+/// order, renumbered densely, and the triangles over them, reversed where `flip` differs
+/// from `inverted`.
+fn renumbered(
+    v: &[Point3<f64>],
+    tris: &[[usize; 3]],
+    flip: &[bool],
+    inverted: bool,
+) -> (Vec<Point3<f64>>, Vec<[usize; 3]>) {
+    let mut index = vec![usize::MAX; v.len()];
+    for tri in tris {
+        for &i in tri {
+            index[i] = 0;
+        }
+    }
+    let mut vertices = Vec::new();
+    for (i, slot) in index.iter_mut().enumerate() {
+        if *slot == 0 {
+            *slot = vertices.len();
+            vertices.push(v[i]);
+        }
+    }
+    let triangles = tris
+        .iter()
+        .zip(flip)
+        .map(|(tri, &f)| {
+            let [a, b, c] = tri.map(|i| index[i]);
+            if f ^ inverted { [a, c, b] } else { [a, b, c] }
+        })
+        .collect();
+    (vertices, triangles)
 }
 
 /// A repeated vertex or an exactly zero (or non-finite) cross product.

@@ -1,8 +1,8 @@
 //! The one error type of the crate: every public entry validates its input
 //! and reports the offending values here.
 
-/// Everything that can go wrong when building a grading, a domain, a packing,
-/// running the genetic algorithm, writing an output or reading one back.
+/// Everything that can go wrong when building a grading, a domain, a 2D
+/// packing, running the genetic algorithm or writing an output.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
@@ -84,20 +84,6 @@ pub enum Error {
         /// Index of the second edge.
         second: usize,
     },
-    /// Two vertices of a polygon or polyhedron coincide.
-    #[error("vertices {first} and {second} coincide")]
-    RepeatedVertex {
-        /// Index of the first vertex.
-        first: usize,
-        /// Index of the second vertex.
-        second: usize,
-    },
-    /// A polygon or polyhedron that must be convex is not.
-    #[error("shape is not convex at vertex {vertex}")]
-    NotConvex {
-        /// Index of the first offending vertex.
-        vertex: usize,
-    },
     /// A polygon with zero area.
     #[error("polygon has zero area")]
     DegeneratePolygon,
@@ -132,93 +118,6 @@ pub enum Error {
     Empty {
         /// What is empty.
         what: &'static str,
-    },
-    /// A container mesh that cannot be used (open, non-manifold,
-    /// inconsistently oriented, degenerate), as levelset reports it.
-    #[error("container mesh: {0}")]
-    Mesh(#[from] levelset::Error),
-    /// A text format that cannot be read: the format, the 1-based line
-    /// number (one past the last line for problems found at the end of the
-    /// input) and what is wrong there.
-    #[error("{format} line {line}: {message}")]
-    Parse {
-        /// Format name (`"lammps data"`, `"yade text"`, `"csv"`, `"vtu"`).
-        format: &'static str,
-        /// 1-based line number.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A margin that leaves no core region inside the container.
-    #[error("margin {margin} leaves an empty core region")]
-    EmptyCore {
-        /// The offending margin.
-        margin: f64,
-    },
-    /// A metric that only applies to one kind of container.
-    #[error("{what} needs a {expected} container, got a {got}")]
-    WrongContainer {
-        /// The metric.
-        what: &'static str,
-        /// The container kind it needs.
-        expected: &'static str,
-        /// The container kind given.
-        got: &'static str,
-    },
-    /// The independent checker could not build its own (parry) copy of a
-    /// container mesh.
-    #[error("checker mesh: {reason}")]
-    CheckerMesh {
-        /// What parry reported.
-        reason: String,
-    },
-    /// A grain's star table or its rasterisation was refused by levelset.
-    #[error("star grain: {0}")]
-    StarTable(levelset::Error),
-    /// The grains fill too much of the container to be packed (or the
-    /// sphere skeleton could not place them all).
-    #[error("grains fill {fraction} of the container, more than can be packed (limit {limit})")]
-    TooDense {
-        /// Grain volume over container volume.
-        fraction: f64,
-        /// The largest fraction attempted.
-        limit: f64,
-    },
-    /// Trimming the clumps of a packing would take most of a sphere away (the packing is
-    /// tighter than a clump of so few spheres can follow).
-    #[error(
-        "clump of shape {shape}: a sphere of radius {radius} would lose {percent:.0} % of it to its neighbours; use more spheres per clump"
-    )]
-    ClumpTrimTooDeep {
-        /// The shape (template) index.
-        shape: usize,
-        /// The sphere's radius.
-        radius: f64,
-        /// The radius it would lose, in percent.
-        percent: f64,
-    },
-    /// Overlap removal did not finish within the allowed sweeps.
-    #[error(
-        "overlaps remain after {sweeps} sweeps ({overlapping_pairs} pairs at grain scale {scale})"
-    )]
-    NotConverged {
-        /// Sweeps run.
-        sweeps: usize,
-        /// Pairs still closer than the margin.
-        overlapping_pairs: usize,
-        /// Grain scale reached by the growth (1 = full size).
-        scale: f64,
-    },
-    /// A requested solid fraction lies beyond what the densification can
-    /// free of overlaps (beyond jamming).
-    #[error(
-        "solid fraction {requested} cannot be reached: the packing jams at {reached:.4} (the densest overlap-free state found)"
-    )]
-    FractionNotReached {
-        /// The requested fraction.
-        requested: f64,
-        /// The highest overlap-free fraction reached.
-        reached: f64,
     },
     /// An I/O error from a reader or a writer.
     #[error("reading or writing failed: {0}")]

@@ -504,7 +504,7 @@ const TWO_OVER_SQRT_PI: f64 = std::f64::consts::FRAC_2_SQRT_PI;
 /// `erfc x = e^{−x²}/√π · 1/(x + ½/(x + 1/(x + 3/2/(x + …))))`
 /// (A&S Eq. 7.1.14), evaluated by the modified Lentz method;
 /// `erfc(−x) = 2 − erfc(x)`.
-pub(crate) fn erfc(x: f64) -> f64 {
+pub fn erfc(x: f64) -> f64 {
     if x.is_nan() {
         return f64::NAN;
     }
@@ -558,7 +558,7 @@ fn erf_series(x: f64) -> f64 {
 }
 
 /// Standard normal CDF `Φ(z) = erfc(−z/√2)/2`.
-pub(crate) fn norm_cdf(z: f64) -> f64 {
+pub fn norm_cdf(z: f64) -> f64 {
     0.5 * erfc(-z * std::f64::consts::FRAC_1_SQRT_2)
 }
 
@@ -567,7 +567,7 @@ pub(crate) fn norm_cdf(z: f64) -> f64 {
 /// precision. `p ≤ 0` gives `−∞`, `p ≥ 1` gives `+∞`; the upper half is
 /// mirrored (`Φ⁻¹(p) = −Φ⁻¹(1 − p)`, `1 − p` exact there) so that every
 /// Halley residual is a lower-tail probability.
-pub(crate) fn norm_ppf(p: f64) -> f64 {
+pub fn norm_ppf(p: f64) -> f64 {
     if p.is_nan() {
         return f64::NAN;
     }
@@ -647,7 +647,7 @@ pub(crate) fn norm_ppf(p: f64) -> f64 {
 /// (the substitution `d = D(v)` in `∫ s³ dF(s)`), which also handles atoms
 /// (constant diameters) exactly. `M` is tabulated once by two-point
 /// Gauss–Legendre on `2¹⁴` equal cells of `u`.
-pub(crate) struct MassCurve<'a> {
+pub struct MassCurve<'a> {
     grading: &'a Grading,
     /// `M(k / N)`, `k = 0..=N`, normalised to end at 1.
     cum: Vec<f64>,
@@ -657,7 +657,7 @@ impl<'a> MassCurve<'a> {
     const CELLS: usize = 1 << 14;
 
     /// Tabulates `M` for a validated grading.
-    pub(crate) fn new(grading: &'a Grading) -> Self {
+    pub fn new(grading: &'a Grading) -> Self {
         let n = Self::CELLS;
         let h = 1.0 / n as f64;
         let off = 0.5 / 3f64.sqrt();
@@ -689,12 +689,12 @@ impl<'a> MassCurve<'a> {
     }
 
     /// Mass fraction (0–1) passing the size `d`.
-    pub(crate) fn passing(&self, d: f64) -> f64 {
+    pub fn passing(&self, d: f64) -> f64 {
         self.at_u(self.grading.passing_at(d))
     }
 
     /// Size at which the mass fraction `x ∈ [0, 1]` passes (`D_x` by mass).
-    pub(crate) fn quantile(&self, x: f64) -> f64 {
+    pub fn quantile(&self, x: f64) -> f64 {
         let n = Self::CELLS;
         let x = x.clamp(0.0, 1.0);
         // First node with cum > x: the cell [k, k + 1] holds x.

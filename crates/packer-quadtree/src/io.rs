@@ -49,18 +49,22 @@ pub fn write_vtu(disks: &[Disk], mut w: impl Write) -> Result<()> {
         |i| disks[i].radius,
         |i, w| writeln!(w, "{:e} {:e} 0", disks[i].center.x, disks[i].center.y),
         &mut w,
-    )
+    )?;
+    Ok(())
 }
 
 /// A VTU of `n` points with point arrays `radius` and `diameter` (the
 /// 2D and 3D sphere writers): `radius(i)`, and `centre(i, w)` writes point
 /// `i`'s coordinates line.
-pub(crate) fn write_vtu_glyphs<W: Write>(
+///
+/// # Errors
+/// The writer's I/O error.
+pub fn write_vtu_glyphs<W: Write>(
     n: usize,
     radius: impl Fn(usize) -> f64,
     centre: impl Fn(usize, &mut W) -> std::io::Result<()>,
     w: &mut W,
-) -> Result<()> {
+) -> std::io::Result<()> {
     writeln!(w, r#"<?xml version="1.0"?>"#)?;
     writeln!(
         w,
@@ -94,7 +98,7 @@ pub(crate) fn write_vtu_glyphs<W: Write>(
 /// The end of a VTU of `n` points written as vertex cells: closes the
 /// points array, writes connectivity, offsets and types (VTK_VERTEX) and
 /// closes the file (shared by the 2D and 3D writers).
-fn write_vtu_vertex_cells(n: usize, w: &mut impl Write) -> Result<()> {
+fn write_vtu_vertex_cells(n: usize, w: &mut impl Write) -> std::io::Result<()> {
     writeln!(w, "</DataArray>")?;
     writeln!(w, "</Points>")?;
     writeln!(w, "<Cells>")?;

@@ -1,5 +1,6 @@
-//! Advancing-front dense packing of disks (Pinto 2009) and of general
-//! grains by particle-in-contact solvers (Pérez Morales et al. 2016).
+//! Seed 004: the advancing-front dense packing of disks (Pinto 2009) with
+//! its MX quadtree / cell grid, gradings, genetic porosity control and 2D
+//! outputs.
 //!
 //! Purpose: fill a 2D domain with non-overlapping disks that follow a
 //! prescribed grading, fast, and write them for DEM codes.
@@ -25,28 +26,18 @@
 //! * metrics: [`porosity`] (Eq. 4-2), [`porosity_in_window`],
 //!   [`check_packing`] (independent brute-force overlap/containment check,
 //!   contacts, coordination number, minimum gap);
-//! * 3D sphere packings ([`Sphere`] in a [`Container`]: box, periodic
-//!   box, cylinder, closed mesh) and their metrics: [`check_spheres`]
-//!   (independent cell-grid overlap and containment check, contacts,
-//!   coordination), [`solid_fraction`], [`core_solid_fraction`] (exact for
-//!   boxes and cylinders), [`radial_profile`] of a cylindrical specimen and
-//!   [`grading_report`] (mass-based D10/D30/D60, Cu, Cc);
 //! * [`optimise_porosity`]: genetic porosity control (§4.1–4.2);
 //!   [`graded_layers`]: functionally graded property layers (§4.3);
 //! * writers: [`write_csv`], [`write_vtu`], [`write_lammps_data`],
 //!   [`write_yade`], [`write_svg`];
-//! * 3D sphere packings ([`Sphere`] in a [`Container`]): writers and
-//!   bit-exact round-trip readers [`write_lammps_data3`] /
-//!   [`read_lammps_data3`] (LAMMPS/LIGGGHTS `atom_style sphere`),
-//!   [`write_yade3`] / [`read_yade3`], [`write_csv3`] / [`read_csv3`],
-//!   [`write_vtu3`] / [`read_vtu3`];
-//! * particle in contact (Pérez Morales et al. 2016): closed-form wrappers
-//!   [`contact2d`] and [`contact3d`], gap functions with Newton and
-//!   Nelder–Mead [`gap`], grain shapes ([`Grain`], [`GrainShape`]:
-//!   disks/spheres, spherocylinders, clusters, convex polygons/polyhedra),
-//!   packings [`pack_pic`] in a square or cube ([`PicParams`],
-//!   [`ContactMethod`], presets [`PicParams::perezmorales2016`]), the
-//!   independent parry checker [`check_pic`] and [`write_pic_vtu`].
+//! * shared with the 3D packers (`packer-spheres`): [`MassCurve`] (mass
+//!   passing of a number grading), [`write_vtu_glyphs`] and the normal
+//!   distribution helpers [`erfc`], [`norm_cdf`], [`norm_ppf`].
+//!
+//! The other packers live in their own crates: `packer-spheres` (the 3D
+//! sphere front and its densification), `packer-contact` (the
+//! particle-in-contact solvers of Pérez Morales et al. 2016) and
+//! `packer-grains` (packings of star-shaped grains).
 //!
 //! ```
 //! use packer_quadtree::{pack, check_packing, porosity, Domain, Grading, PackParams};
@@ -80,51 +71,25 @@
 // Seeded randomised tests print their seed (house style).
 #![cfg_attr(test, allow(clippy::print_stdout))]
 
-mod clump_trim;
-pub mod contact2d;
-pub mod contact3d;
 mod domain;
 mod error;
 mod ga;
-pub mod gap;
 mod grading;
-pub mod grains3d;
 mod index;
 mod io;
 mod metrics;
-mod pack3d;
 mod packer;
-mod pic;
-mod shapes;
 
-pub use clump_trim::{ClumpTrim, separate_clumps};
 pub use domain::Domain;
 pub use error::{Error, Result};
 pub use ga::{GaParams, GaResult, graded_layers, optimise_porosity};
-pub use grading::{Grading, MixtureComponent, estimate_count};
-pub use grains3d::{
-    CheckParams, Fabric, GrainOverlapReport, GrainPackParams, GrainPackStats, GrainPacking,
-    StarGrain, boundary_for, check_grain_overlaps, check_grain_overlaps_in, container_for,
-    occupied, occupied_in, orientation_fabric, pack_grains, pack_grains_in, random_rotation,
-};
+pub use grading::{Grading, MassCurve, MixtureComponent, erfc, estimate_count, norm_cdf, norm_ppf};
 pub use index::{CellGrid, MxQuadtree, SpatialIndex};
-pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_yade};
+pub use io::{write_csv, write_lammps_data, write_svg, write_vtu, write_vtu_glyphs, write_yade};
 pub use metrics::{
     OverlapReport, Window, check_packing, disk_window_area, porosity, porosity_in_window,
-};
-pub use pack3d::{
-    Boundary, Container, CoreFraction, DensePacking3, Densified, DensifyParams, DensifyStats,
-    GradingReport, GradingStats, LammpsData3, MeshContainer, Pack3Params, Pack3Stats, Packing3,
-    RadialBin, Sphere, SphereReport, Target, check_spheres, core_solid_fraction, densify,
-    grading_report, max_overlap, pack3d, pack3d_dense, pack3d_seeded, pack3d_sizes, radial_profile,
-    read_csv3, read_lammps_data3, read_vtu3, read_yade3, solid_fraction, write_csv3,
-    write_lammps_data3, write_vtu3, write_yade3,
 };
 pub use packer::{
     BoundaryMode, Disk, FrontOrder, HaloMode, PackParams, PackStats, Packing, pack, pack_seeded,
     pack_sizes, pack_sizes_with_index, pack_with_index,
 };
-pub use pic::{
-    ContactMethod, PicPacking, PicParams, PicReport, Placed, check_pic, pack_pic, write_pic_vtu,
-};
-pub use shapes::{Geometry, Grain, GrainShape, ParryConvex, Swept};

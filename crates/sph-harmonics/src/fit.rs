@@ -18,7 +18,7 @@
 
 use crate::basis::{Legendre, coefficient_count, fill_row, index, tri};
 use crate::error::{Error, check_angles, check_finite};
-use crate::grid::RingGrid;
+use crate::grid::{Ring, RingGrid};
 use crate::model::ShModel;
 use faer::Mat;
 use faer::linalg::solvers::SolveLstsq;
@@ -281,8 +281,47 @@ pub fn least_squares_rings(grid: &RingGrid, radii: &[f64], degree: usize) -> Res
         });
     }
     let leg = Legendre::new(degree)?;
-    let mut vals = leg.buffer(0);
     let rings = grid.rings();
+    let projections = project_rings(rings, radii, degree, &leg);
+    let blocks = solve_ring_blocks(rings, &projections, degree, n_coef)?;
+    let coef = blocks.coefficients;
+    check_finite("fitted coefficient", &coef)?;
+    let (rank, smax, smin, cond) = rank_from(&blocks.singular_values, grid.len(), n_coef);
+    let rank_deficient = blocks.any_deficient || rank < n_coef;
+    let model = ShModel::new(degree, coef)?;
+    let ss = (projections.total_ss - blocks.explained).max(0.0);
+    Ok(Fit {
+        model,
+        diagnostics: FitDiagnostics {
+            method: FitMethod::RingBlocks,
+            n_points: grid.len(),
+            n_coefficients: n_coef,
+            rank,
+            singular_max: smax,
+            singular_min: smin,
+            condition_number: cond,
+            rank_deficient,
+            ill_conditioned: cond > ILL_CONDITIONED,
+            rms_residual: (ss / grid.len() as f64).sqrt(),
+        },
+    })
+}
+
+/// The data of a separable ring grid reduced ring by ring (see [`project_rings`]).
+struct RingProjections {
+    /// Legendre values `P_lm(cos θ)` per ring (indexed by [`tri`]).
+    legendre: Vec<Vec<f64>>,
+    /// Weighted projections per ring and order: `proj[ring][m] = (cos part, sin part)`.
+    proj: Vec<Vec<(f64, f64)>>,
+    /// Weighted sum of squares of all data, `Σ w_i r_i²`.
+    total_ss: f64,
+}
+
+/// Legendre values and projected data of every ring of a separable grid: the data of a
+/// ring projected on its orthonormal cos mφ, sin mφ (m ≤ degree; m = 0 only on a pole),
+/// scaled by the square root of the ring's weight.
+fn project_rings(rings: &[Ring], radii: &[f64], degree: usize, leg: &Legendre) -> RingProjections {
+    let mut vals = leg.buffer(0);
     let nr = rings.len();
     // Legendre values per ring and projected data per ring: proj[ring][m] = (cos part, sin part).
     let mut ptab = Vec::with_capacity(nr);
@@ -299,44 +338,74 @@ pub fn least_squares_rings(grid: &RingGrid, radii: &[f64], degree: usize) -> Res
         total_ss += ring.weight * data.iter().map(|v| v * v).sum::<f64>();
         let mmax = if ring.is_pole() { 0 } else { degree };
         for (m, slot) in proj[i].iter_mut().enumerate().take(mmax + 1) {
-            // Σ_j r_j cos(m φ_j), Σ_j r_j sin(m φ_j) by an angle-addition recurrence.
-            let (sm0, cm0) = (m as f64 * ring.phi0).sin_cos();
-            let (ms1, mc1) = if m == 0 {
-                (0.0, 1.0)
-            } else {
-                (m as f64 * 2.0 * std::f64::consts::PI / n as f64).sin_cos()
-            };
-            let (mut s, mut c) = (sm0, cm0);
-            let (mut cs, mut ss) = (0.0, 0.0);
-            for &v in data {
-                cs += v * c;
-                ss += v * s;
-                let cn = c * mc1 - s * ms1;
-                s = s * mc1 + c * ms1;
-                c = cn;
-            }
-            let nf = n as f64;
-            *slot = if m == 0 {
-                (sw * cs / nf.sqrt(), 0.0)
-            } else {
-                let norm = (nf / 2.0).sqrt();
-                (sw * cs / norm, sw * ss / norm)
-            };
+            *slot = ring_projection(ring, data, m, sw);
         }
     }
+    RingProjections {
+        legendre: ptab,
+        proj,
+        total_ss,
+    }
+}
+
+/// The projection of one ring's `data` on the orthonormal cos mφ, sin mφ of the ring,
+/// scaled by `sw` (the square root of the ring's weight): (cos part, sin part).
+fn ring_projection(ring: &Ring, data: &[f64], m: usize, sw: f64) -> (f64, f64) {
+    let n = ring.n_phi;
+    // Σ_j r_j cos(m φ_j), Σ_j r_j sin(m φ_j) by an angle-addition recurrence.
+    let (sm0, cm0) = (m as f64 * ring.phi0).sin_cos();
+    let (ms1, mc1) = if m == 0 {
+        (0.0, 1.0)
+    } else {
+        (m as f64 * 2.0 * std::f64::consts::PI / n as f64).sin_cos()
+    };
+    let (mut s, mut c) = (sm0, cm0);
+    let (mut cs, mut ss) = (0.0, 0.0);
+    for &v in data {
+        cs += v * c;
+        ss += v * s;
+        let cn = c * mc1 - s * ms1;
+        s = s * mc1 + c * ms1;
+        c = cn;
+    }
+    let nf = n as f64;
+    if m == 0 {
+        (sw * cs / nf.sqrt(), 0.0)
+    } else {
+        let norm = (nf / 2.0).sqrt();
+        (sw * cs / norm, sw * ss / norm)
+    }
+}
+
+/// The solution of the block-diagonal problem of [`least_squares_rings`].
+struct RingBlocks {
+    /// The coefficients, in [`index`] order.
+    coefficients: Vec<f64>,
+    /// Singular values of the full design (every block column counted once per part).
+    singular_values: Vec<f64>,
+    /// Whether some block was solved by its pseudo-inverse.
+    any_deficient: bool,
+    /// `Σ (‖b‖² − ‖b − A x‖²)` over the blocks: the explained sum of squares.
+    explained: f64,
+}
+
+/// Solves the 2L+1 blocks (order m; cos part, and sin part for m > 0) by QR, or by the
+/// pseudo-inverse when a block is rank deficient or has fewer rows than columns.
+fn solve_ring_blocks(
+    rings: &[Ring],
+    projections: &RingProjections,
+    degree: usize,
+    n_coef: usize,
+) -> Result<RingBlocks, Error> {
+    let (ptab, proj) = (&projections.legendre, &projections.proj);
+    let nr = rings.len();
     let mut coef = vec![0.0; n_coef];
     let mut all_sv = Vec::with_capacity(n_coef);
     let mut any_deficient = false;
     let mut explained = 0.0;
     for m in 0..=degree {
         let ncol = degree - m + 1;
-        let mut a = Mat::<f64>::zeros(nr, ncol);
-        for (i, ring) in rings.iter().enumerate() {
-            let f = (ring.weight * ring.n_phi as f64).sqrt();
-            for l in m..=degree {
-                a[(i, l - m)] = f * ptab[i][tri(l, m)];
-            }
-        }
+        let a = block_design(rings, ptab, m, degree);
         let sv = a.singular_values().map_err(|_| Error::LinearAlgebra {
             what: "block singular values did not converge",
         })?;
@@ -384,26 +453,26 @@ pub fn least_squares_rings(grid: &RingGrid, radii: &[f64], degree: usize) -> Res
             all_sv.extend_from_slice(&padded);
         }
     }
-    check_finite("fitted coefficient", &coef)?;
-    let (rank, smax, smin, cond) = rank_from(&all_sv, grid.len(), n_coef);
-    let rank_deficient = any_deficient || rank < n_coef;
-    let model = ShModel::new(degree, coef)?;
-    let ss = (total_ss - explained).max(0.0);
-    Ok(Fit {
-        model,
-        diagnostics: FitDiagnostics {
-            method: FitMethod::RingBlocks,
-            n_points: grid.len(),
-            n_coefficients: n_coef,
-            rank,
-            singular_max: smax,
-            singular_min: smin,
-            condition_number: cond,
-            rank_deficient,
-            ill_conditioned: cond > ILL_CONDITIONED,
-            rms_residual: (ss / grid.len() as f64).sqrt(),
-        },
+    Ok(RingBlocks {
+        coefficients: coef,
+        singular_values: all_sv,
+        any_deficient,
+        explained,
     })
+}
+
+/// The design matrix of block m: one row per ring, one column per degree l = m..=degree,
+/// entries `√(w·n_φ)·P_lm(cos θ)`.
+fn block_design(rings: &[Ring], ptab: &[Vec<f64>], m: usize, degree: usize) -> Mat<f64> {
+    let ncol = degree - m + 1;
+    let mut a = Mat::<f64>::zeros(rings.len(), ncol);
+    for (i, ring) in rings.iter().enumerate() {
+        let f = (ring.weight * ring.n_phi as f64).sqrt();
+        for l in m..=degree {
+            a[(i, l - m)] = f * ptab[i][tri(l, m)];
+        }
+    }
+    a
 }
 
 /// Coefficients by quadrature, `a_lm = Σ w_i r_i Y_lm(θ_i, φ_i)` with the grid's weights.

@@ -6,9 +6,8 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use levelset::nalgebra::Vector3;
-use packer_quadtree::{
-    CheckParams, Container, StarGrain, check_grain_overlaps, orientation_fabric,
-};
+use packer_grains::{CheckParams, StarGrain, check_grain_overlaps, orientation_fabric};
+use packer_spheres::Container;
 use std::time::Instant;
 use validate::cases::specimen::{mass_cu_cc, ottawa_star_grains, pack_specimen};
 
@@ -54,9 +53,9 @@ fn main() {
     } else {
         let mut out = None;
         for f in fr {
-            let c = packer_quadtree::container_for(&shape, &grains, f).unwrap();
+            let c = packer_grains::container_for(&shape, &grains, f).unwrap();
             let t1 = Instant::now();
-            let params = packer_quadtree::GrainPackParams {
+            let params = packer_grains::GrainPackParams {
                 max_sweeps: sweeps,
                 relaxation: std::env::var("OMEGA").map_or(1.8, |v| v.parse().unwrap()),
                 rotations: std::env::var("ROT").map_or(true, |v| v != "0"),
@@ -64,7 +63,7 @@ fn main() {
                 coarse_nodes: std::env::var("COARSE").map_or(160, |v| v.parse().unwrap()),
                 ..Default::default()
             };
-            match packer_quadtree::pack_grains(&grains, &c, &params) {
+            match packer_grains::pack_grains(&grains, &c, &params) {
                 Ok(p) => {
                     println!("fraction {f}: ok in {:.2} s", t1.elapsed().as_secs_f64());
                     out = Some((c, p));

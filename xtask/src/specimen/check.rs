@@ -313,14 +313,14 @@ pub(crate) fn settle_text(
     bodies: usize,
     spheres: usize,
     d50: f64,
-    container: &packer_quadtree::Container,
+    container: &packer_spheres::Container,
 ) -> String {
     let (lo, hi) = container.bbox();
     let mut s = format!(
         "# what cargo xtask specimen-check compares a settled deck with (SI)\nbodies {bodies}\nspheres {spheres}\nd50 {d50:e}\nbox {:e} {:e} {:e} {:e} {:e} {:e}\n",
         lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
     );
-    if let packer_quadtree::Container::Cylinder {
+    if let packer_spheres::Container::Cylinder {
         base,
         radius,
         height,

@@ -59,7 +59,7 @@ use std::fmt::Write as _;
 
 use anyhow::{Context, bail, ensure};
 use nalgebra::{Isometry3, Matrix3, Point3};
-use packer_quadtree::Container;
+use packer_spheres::Container;
 use serde::Deserialize;
 
 /// Steps between two kinetic-energy checks.

@@ -24,7 +24,8 @@ use anyhow::{Context, bail};
 use clap::Args;
 use cloner::{Calibrated, CloneModel, Hooks};
 use nalgebra::{Isometry3, Point3};
-use packer_quadtree::{Container, Sphere, StarGrain};
+use packer_grains::StarGrain;
+use packer_spheres::{Container, Sphere};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
@@ -376,7 +377,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         // refuse a narrow container before spending the packing on it
         let planned = match &fixed {
             Some(c) => c.clone(),
-            None => packer_quadtree::container_for(
+            None => packer_grains::container_for(
                 &Container::triaxial(1.0),
                 grains,
                 auto.map_or(0.5, |a| a.0),
@@ -463,11 +464,11 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
     let t = Instant::now();
     if let Some(grains) = &grains {
         let pb = crate::progress::spinner("checking overlaps", quiet);
-        let r = packer_quadtree::check_grain_overlaps(
+        let r = packer_grains::check_grain_overlaps(
             grains,
             &poses,
             &container,
-            &packer_quadtree::CheckParams::default(),
+            &packer_grains::CheckParams::default(),
         )?;
         pb.finish_and_clear();
         if !r.is_clean() {
@@ -480,7 +481,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 r.raster_overlap_voxels
             );
         }
-        let fabric = packer_quadtree::orientation_fabric(&poses, &nalgebra::Vector3::x())?;
+        let fabric = packer_grains::orientation_fabric(&poses, &nalgebra::Vector3::x())?;
         let fraction = grain_stats.map_or(f64::NAN, |s| s.solid_fraction);
         st.ran(
             "check",
@@ -504,7 +505,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 radius: *r,
             })
             .collect();
-        let check = packer_quadtree::check_spheres(&container, &spheres, 1e-9)?;
+        let check = packer_spheres::check_spheres(&container, &spheres, 1e-9)?;
         if !check.is_clean(1e-9) {
             bail!(
                 "the independent checker rejects the placement (worst pair gap / d {:.2e}, wall {:.2e})",
@@ -512,7 +513,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
                 check.worst_normalised_wall_gap
             );
         }
-        let sphere_fraction = packer_quadtree::solid_fraction(&container, &spheres)?;
+        let sphere_fraction = packer_spheres::solid_fraction(&container, &spheres)?;
         let grain_volume: f64 = (0..n_grains)
             .map(|k| {
                 let t = template_of(k);
@@ -761,7 +762,7 @@ pub(crate) fn run_scene(scene: &Scene, root: &Path, quiet: bool) -> anyhow::Resu
         None => {
             let n: usize = template_spheres.iter().map(Vec::len).sum();
             let t = Instant::now();
-            let tr = packer_quadtree::separate_clumps(
+            let tr = packer_grains::separate_clumps(
                 &mut template_spheres,
                 &poses,
                 template_of,

@@ -2,7 +2,7 @@
 //! clones into poses (clone frame → world).
 //!
 //! [`place_grains`] (scene `placement: Grains`, the default) packs the
-//! clones' star surfaces themselves with `packer_quadtree::pack_grains`
+//! clones' star surfaces themselves with `packer_grains::pack_grains`
 //! (sphere skeleton, then gap minimisation with the LS-DEM node test and
 //! rigid moves): dense, and checked afterwards on level sets by
 //! `check_grain_overlaps` in the `check` stage.
@@ -11,7 +11,7 @@
 //! clone's bounding sphere
 //! (its largest node radius about the clone's origin, times
 //! [`BOUNDING_MARGIN`] for the interpolation between mesh nodes) is packed
-//! by `packer_quadtree::pack3d_sizes` in the container, sizes as given, and
+//! by `packer_spheres::pack3d_sizes` in the container, sizes as given, and
 //! every clone gets an isotropic random rotation from its own
 //! `(seed, index)` stream. Bounding spheres do not overlap, so neither do
 //! the grains: non-overlapping by construction, and loose (the grains fill
@@ -20,9 +20,8 @@
 
 use anyhow::bail;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
-use packer_quadtree::{
-    Container, GrainPackParams, GrainPackStats, Pack3Params, StarGrain, container_for, pack_grains,
-};
+use packer_grains::{GrainPackParams, GrainPackStats, StarGrain, container_for, pack_grains};
+use packer_spheres::{Container, Pack3Params};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -96,7 +95,7 @@ pub(crate) fn place(
         Preset::Default => Pack3Params::default(),
         Preset::Dense => Pack3Params::dense(),
     };
-    let packing = packer_quadtree::pack3d_sizes(container, &sizes, lo, hi, &params)?;
+    let packing = packer_spheres::pack3d_sizes(container, &sizes, lo, hi, &params)?;
     if packing.spheres.len() < clones.len() {
         return Err(ContainerFull {
             clones: clones.len(),
@@ -194,12 +193,12 @@ pub(crate) fn place_grains(
     let params = grain_params(preset, seed);
     let largest = grains.iter().map(|g| 2.0 * g.r_max()).fold(0.0, f64::max);
     let total: f64 = grains.iter().map(StarGrain::volume).sum();
-    let too_dense = |e: &packer_quadtree::Error| {
+    let too_dense = |e: &packer_grains::Error| {
         matches!(
             e,
-            packer_quadtree::Error::NotConverged { .. }
-                | packer_quadtree::Error::TooDense { .. }
-                | packer_quadtree::Error::FractionNotReached { .. }
+            packer_grains::Error::NotConverged { .. }
+                | packer_grains::Error::TooDense { .. }
+                | packer_grains::Error::FractionNotReached { .. }
         )
     };
     if let Some(c) = container {
@@ -249,16 +248,16 @@ pub(crate) fn place_grains(
                 Err(e) if too_dense(&e) => {
                     last = match e {
                         // grains at scale λ fill λ³ of their volume
-                        packer_quadtree::Error::NotConverged { scale, .. } if scale < 1.0 => {
+                        packer_grains::Error::NotConverged { scale, .. } if scale < 1.0 => {
                             format!(
                                 "at solid fraction {fraction:.4} the packer separated the grains only at scale {scale:.4} of their size, i.e. solid fraction {:.4} ({e})",
                                 fraction * scale.powi(3)
                             )
                         }
-                        packer_quadtree::Error::FractionNotReached { reached, .. } => format!(
+                        packer_grains::Error::FractionNotReached { reached, .. } => format!(
                             "at solid fraction {fraction:.4} the compaction jammed: the grains were separated up to solid fraction {reached:.4} ({e})"
                         ),
-                        packer_quadtree::Error::NotConverged { .. } => format!(
+                        packer_grains::Error::NotConverged { .. } => format!(
                             "at solid fraction {fraction:.4} the grains grew to full size but no overlap-free packing was found ({e})"
                         ),
                         _ => format!("at solid fraction {fraction:.4}: {e}"),
@@ -326,7 +325,7 @@ pub(crate) fn wall_share(c: &Container, poses: &[Isometry3<f64>], d_max: f64) ->
 pub(crate) fn random_rotation(seed: u64, index: u64) -> UnitQuaternion<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ ROTATION_STREAM);
     rng.set_stream(index);
-    packer_quadtree::random_rotation(&mut rng)
+    packer_grains::random_rotation(&mut rng)
 }
 
 #[cfg(test)]
@@ -380,11 +379,11 @@ mod tests {
         assert_eq!(auto.poses.len(), g.len());
         assert!((auto.stats.solid_fraction - 0.45).abs() < 1e-9);
         assert_eq!(auto.tries, 1);
-        let r = packer_quadtree::check_grain_overlaps(
+        let r = packer_grains::check_grain_overlaps(
             &g,
             &auto.poses,
             &auto.container,
-            &packer_quadtree::CheckParams::default(),
+            &packer_grains::CheckParams::default(),
         )
         .expect("check");
         assert!(r.is_clean(), "{r:?}");

@@ -257,7 +257,7 @@ pub(crate) enum ContainerSpec {
 /// How the clones are placed in the container.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 pub(crate) enum Placement {
-    /// `packer_quadtree::pack_grains`: the star surfaces of the clones
+    /// `packer_grains::pack_grains`: the star surfaces of the clones
     /// packed densely without overlap (sphere skeleton, then gap
     /// minimisation with rotations), checked by `check_grain_overlaps`.
     #[default]

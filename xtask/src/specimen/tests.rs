@@ -559,7 +559,7 @@ fn base64_matches_rfc_4648_and_round_trips() {
 #[test]
 fn separate_clumps_leaves_no_overlap_between_clumps_or_with_walls() {
     use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
-    use packer_quadtree::separate_clumps;
+    use packer_grains::separate_clumps;
     let at =
         |x: f64| Isometry3::from_parts(Translation3::new(x, 5.0, 5.0), UnitQuaternion::identity());
     let mut shapes = vec![
@@ -568,7 +568,7 @@ fn separate_clumps_leaves_no_overlap_between_clumps_or_with_walls() {
         vec![(Point3::origin(), 1.0)],
     ];
     let poses = [at(4.0), at(6.2), at(0.5)];
-    let c = packer_quadtree::Container::walled_box(nalgebra::Vector3::new(10.0, 10.0, 10.0));
+    let c = packer_spheres::Container::walled_box(nalgebra::Vector3::new(10.0, 10.0, 10.0));
     let t = separate_clumps(&mut shapes, &poses, |k| k, &c).expect("trims");
     assert_eq!(t.walls, 1);
     assert!(t.pairs == 1 && t.trimmed == 3, "{t:?}");

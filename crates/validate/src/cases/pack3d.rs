@@ -11,11 +11,12 @@
 //! `cargo xtask pack --dim 3` timing report (10⁶) do.
 
 use levelset::nalgebra::{Point3, Vector3};
-use packer_quadtree::{
-    Boundary, Container, DensePacking3, DensifyParams, Grading, Pack3Params, Packing3, Sphere,
-    Target, check_spheres, core_solid_fraction, grading_report, max_overlap, pack3d_dense,
-    pack3d_seeded, radial_profile, read_csv3, read_lammps_data3, read_vtu3, read_yade3,
-    solid_fraction, write_csv3, write_lammps_data3, write_vtu3, write_yade3,
+use packer_quadtree::Grading;
+use packer_spheres::{
+    Boundary, Container, DensePacking3, DensifyParams, Pack3Params, Packing3, Sphere, Target,
+    check_spheres, core_solid_fraction, grading_report, max_overlap, pack3d_dense, pack3d_seeded,
+    radial_profile, read_csv3, read_lammps_data3, read_vtu3, read_yade3, solid_fraction,
+    write_csv3, write_lammps_data3, write_vtu3, write_yade3,
 };
 
 use crate::{Case, Check, Error, ExpectedFailure, Tolerance};

@@ -25,7 +25,7 @@
 //! 18 900). The exact Newton clusters it replaces (`METHOD=newton`) pack
 //! 7333 grains at 0.542 but at 221 grains/s.
 
-use packer_quadtree::{PicParams, PicReport, check_pic, pack_pic};
+use packer_contact::{PicParams, PicReport, check_pic, pack_pic};
 
 use crate::fixtures::Table;
 use crate::{Case, Check, Error, ExpectedFailure, Tolerance};

@@ -11,7 +11,7 @@
 //! surface deviation in equivalent diameters.
 //!
 //! `specimen/cylinder-10k`: 10 000 clones packed in a triaxial cylinder
-//! (H = 2 D) at a solid fraction of 0.50 by `packer_quadtree::pack_grains`
+//! (H = 2 D) at a solid fraction of 0.50 by `packer_grains::pack_grains`
 //! and checked by `check_grain_overlaps` (1000 nodes per grain on the zero
 //! of its 32³ level set, sampled in every neighbour's; the 16 closest
 //! pairs rasterised 4× finer); the packed grading (Cu, Cc) against the
@@ -21,7 +21,7 @@
 //! `pack_grains` with its default compaction stage: zero overlaps by the
 //! same check, Cu/Cc within 5 %, fabric ≤ 0.02. `specimen/homogeneity`
 //! samples that specimen on a regular grid (spacing d50/6, with
-//! `packer_quadtree::occupied`) in 5 height slices and 3 equal-volume
+//! `packer_grains::occupied`) in 5 height slices and 3 equal-volume
 //! radial shells one d50 off the walls: fractions within ±0.01 of the
 //! core's, mass d50 within 3 % of the specimen's (the core against the
 //! target 0.60 is an expected failure: the wall zone is looser, so the core
@@ -35,11 +35,12 @@
 use cloner::{Calibrated, CloneModel, Hooks};
 use levelset::clump::{ClumpParams, clump, clump_quality};
 use levelset::nalgebra::Vector3;
-use packer_quadtree::{
-    Boundary, CheckParams, Container, GrainPackParams, StarGrain, boundary_for,
-    check_grain_overlaps, check_grain_overlaps_in, container_for, occupied_in, orientation_fabric,
-    pack_grains, pack_grains_in,
+use packer_grains::{
+    CheckParams, GrainPackParams, StarGrain, boundary_for, check_grain_overlaps,
+    check_grain_overlaps_in, container_for, occupied_in, orientation_fabric, pack_grains,
+    pack_grains_in,
 };
+use packer_spheres::{Boundary, Container};
 use rayon::prelude::*;
 
 use crate::fixtures;
@@ -207,7 +208,7 @@ pub fn ottawa_star_grains(count: u64) -> Result<Vec<StarGrain>, Error> {
 pub fn pack_specimen(
     grains: &[StarGrain],
     shape: &Container,
-) -> Result<(Container, packer_quadtree::GrainPacking), Error> {
+) -> Result<(Container, packer_grains::GrainPacking), Error> {
     let mut last = None;
     for f in SPECIMEN_FRACTIONS {
         let c = container_for(shape, grains, f).map_err(Error::computation)?;
@@ -305,7 +306,7 @@ pub const DENSE_FRACTION: f64 = 0.60;
 struct Dense {
     grains: Vec<StarGrain>,
     container: Container,
-    packing: packer_quadtree::GrainPacking,
+    packing: packer_grains::GrainPacking,
 }
 
 fn dense_specimen() -> Result<&'static Dense, Error> {
@@ -333,7 +334,7 @@ fn overlap_checks(
     prefix: &str,
     grains: &[StarGrain],
     container: &Container,
-    packing: &packer_quadtree::GrainPacking,
+    packing: &packer_grains::GrainPacking,
 ) -> Result<Vec<Check>, Error> {
     let report = check_grain_overlaps(grains, &packing.poses, container, &CheckParams::default())
         .map_err(Error::computation)?;
@@ -341,7 +342,7 @@ fn overlap_checks(
 }
 
 /// The rows of an independent check's report.
-fn report_checks(prefix: &str, report: &packer_quadtree::GrainOverlapReport) -> Vec<Check> {
+fn report_checks(prefix: &str, report: &packer_grains::GrainOverlapReport) -> Vec<Check> {
     vec![
         Check::new(
             format!("{prefix}worst node phi / d (1000 nodes, 32^3)"),
@@ -438,7 +439,7 @@ fn target_fraction() -> Result<Vec<Check>, Error> {
     // the limit, from container_for and from pack_grains itself (the 0.60
     // cylinder shrunk to 0.72)
     let sized = match container_for(&Container::triaxial(1.0), &grains, 0.72) {
-        Err(e @ packer_quadtree::Error::Parameter { .. }) => {
+        Err(e @ packer_grains::Error::Parameter { .. }) => {
             let m = e.to_string();
             m.contains("0.72") && m.contains("0.70")
         }
@@ -459,7 +460,7 @@ fn target_fraction() -> Result<Vec<Check>, Error> {
         other => other,
     };
     let packed = match pack_grains(&grains, &shrunk, &GrainPackParams::default()) {
-        Err(e @ packer_quadtree::Error::TooDense { .. }) => {
+        Err(e @ packer_grains::Error::TooDense { .. }) => {
             let m = e.to_string();
             m.contains("0.72") && m.contains("0.7")
         }
@@ -649,7 +650,7 @@ fn homogeneity() -> Result<Vec<Check>, Error> {
             }
         }
     }
-    let inside = packer_quadtree::occupied(&d.grains, &d.packing.poses, &points)
+    let inside = packer_grains::occupied(&d.grains, &d.packing.poses, &points)
         .map_err(Error::computation)?;
     let mut hit = [0usize; 10];
     let mut all = [0usize; 10];

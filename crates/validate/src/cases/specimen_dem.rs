@@ -1,7 +1,7 @@
 //! The DEM files of a specimen as the DEM codes read them (issue "Ready-to-run DEM
 //! specimens").
 //!
-//! Every case packs calibrated Ottawa clones with `packer_quadtree::pack_grains` in a
+//! Every case packs calibrated Ottawa clones with `packer_grains::pack_grains` in a
 //! triaxial cylinder at a solid fraction of 0.50 (0.40 for the 60 grains of the LS-DEM
 //! case, whose cylinder is only a few grains wide), as `cargo xtask specimen` does, and takes
 //! each grain's level set from its packed star table (45³ nodes over ±1.1 r_max).
@@ -21,7 +21,7 @@
 //!
 //! `specimen/clump-mass`: 200 grains as clumps of 10, 20 and 50 spheres
 //! (`levelset::clump`), trimmed against their neighbours and the walls
-//! (`packer_quadtree::separate_clumps`, what is delivered): the union's volume, centre of
+//! (`packer_grains::separate_clumps`, what is delivered): the union's volume, centre of
 //! mass and inertia tensor (`levelset::union_mass_properties`) against the level set's,
 //! and the same for the naive sum of the spheres' own masses and inertias (what LAMMPS
 //! `fix rigid/small` and Yade `appendClumped` without discretisation compute).
@@ -37,9 +37,8 @@ use levelset::io::lsdem;
 use levelset::nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 use levelset::{ClumpParams, Grid, clump, union_mass_properties};
 use morph_dna::{Descriptor, MeasureParams};
-use packer_quadtree::{
-    Container, GrainPackParams, StarGrain, container_for, pack_grains, separate_clumps,
-};
+use packer_grains::{GrainPackParams, StarGrain, container_for, pack_grains, separate_clumps};
+use packer_spheres::Container;
 use rayon::prelude::*;
 
 use crate::{Case, Check, Error, ExpectedFailure, Tolerance};

@@ -1,0 +1,231 @@
+//! The region a grain packing fills: its walls (a container, or none) and
+//! its periodic axes, with the periodic images the neighbour searches use.
+//!
+//! Periodic axes are handled by images: the centres are wrapped into the
+//! cell, and a grain within `width` of a periodic face gets an image
+//! (its centre shifted by ± the side) beyond the opposite face, for each
+//! combination of the faces it is near (up to 7 in a corner of a fully
+//! periodic cell). A neighbour search over the centres and their images
+//! then finds every pair closer than `width` once, either directly or
+//! through exactly one image, provided every periodic side is longer than
+//! `2 · width` (checked at entry: sides of at least 3 d_max, the widths
+//! used are at most about d_max plus a margin or a skin).
+
+use nalgebra::{Point3, Vector3};
+
+use packer_spheres::{Boundary, Container};
+
+/// Shift code of the identity (no image): see [`Region::shift`].
+pub(crate) const NO_SHIFT: u8 = 13;
+
+/// Walls and periodic axes of a packing.
+pub(crate) struct Region<'a> {
+    /// The container whose walls bound the grains (its periodic faces are
+    /// not walls); `None` in a fully periodic cell.
+    walls: Option<&'a Container>,
+    lo: Vector3<f64>,
+    hi: Vector3<f64>,
+    period: [bool; 3],
+}
+
+impl<'a> Region<'a> {
+    pub(crate) fn new(boundary: &'a Boundary) -> Self {
+        match boundary {
+            Boundary::Periodic { min, max } => Self {
+                walls: None,
+                lo: min.coords,
+                hi: max.coords,
+                period: [true; 3],
+            },
+            Boundary::Walls(c) => Self::of(c),
+        }
+    }
+
+    pub(crate) fn of(c: &'a Container) -> Self {
+        let (lo, hi) = c.bbox();
+        let [px, py] = c.periodic();
+        Self {
+            walls: Some(c),
+            lo: lo.coords,
+            hi: hi.coords,
+            period: [px, py, false],
+        }
+    }
+
+    /// Distance to the nearest wall, positive inside (`+inf` without walls).
+    #[inline]
+    pub(crate) fn clearance(&self, p: &Point3<f64>) -> f64 {
+        self.walls.map_or(f64::INFINITY, |c| c.clearance(p))
+    }
+
+    /// Whether any axis is periodic.
+    pub(crate) fn is_periodic(&self) -> bool {
+        self.period.iter().any(|&p| p)
+    }
+
+    /// Which axes are periodic.
+    pub(crate) fn period(&self) -> [bool; 3] {
+        self.period
+    }
+
+    /// Bounding box of the cell.
+    pub(crate) fn bbox(&self) -> (Vector3<f64>, Vector3<f64>) {
+        (self.lo, self.hi)
+    }
+
+    /// Side `k` of the cell.
+    pub(crate) fn side(&self, k: usize) -> f64 {
+        self.hi[k] - self.lo[k]
+    }
+
+    /// `p` moved by whole sides into `[lo, hi)` on the periodic axes.
+    pub(crate) fn wrap(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        let mut q = *p;
+        for k in 0..3 {
+            if self.period[k] {
+                let l = self.side(k);
+                let t = ((q[k] - self.lo[k]) / l).floor();
+                if t != 0.0 {
+                    q[k] -= t * l;
+                }
+                // rounding may land exactly on hi
+                if q[k] >= self.hi[k] {
+                    q[k] = self.lo[k];
+                }
+            }
+        }
+        q
+    }
+
+    /// The translation of shift code `code`: `(a, b, c) ∈ {−1, 0, 1}³`
+    /// whole sides along x, y, z, coded `(a + 1) + 3 (b + 1) + 9 (c + 1)`.
+    #[inline]
+    pub(crate) fn shift(&self, code: u8) -> Vector3<f64> {
+        let c = i32::from(code);
+        let a = [c % 3 - 1, (c / 3) % 3 - 1, c / 9 - 1];
+        Vector3::new(
+            f64::from(a[0]) * self.side(0),
+            f64::from(a[1]) * self.side(1),
+            f64::from(a[2]) * self.side(2),
+        )
+    }
+
+    /// The periodic images of the (wrapped) `centres` within `width` of a
+    /// periodic face, as `(grain, shift code)`, in grain order.
+    pub(crate) fn images(&self, centres: &[Vector3<f64>], width: f64) -> Vec<(u32, u8)> {
+        let mut out = Vec::new();
+        if !self.is_periodic() {
+            return out;
+        }
+        for (i, p) in centres.iter().enumerate() {
+            // per axis: the shifts the centre needs (0 always)
+            let mut opts = [[0i8; 2]; 3];
+            let mut count = [1usize; 3];
+            for k in 0..3 {
+                if !self.period[k] {
+                    continue;
+                }
+                if p[k] - self.lo[k] < width {
+                    opts[k][1] = 1;
+                    count[k] = 2;
+                } else if self.hi[k] - p[k] < width {
+                    opts[k][1] = -1;
+                    count[k] = 2;
+                }
+            }
+            for c in 0..count[2] {
+                for b in 0..count[1] {
+                    for a in 0..count[0] {
+                        if a + b + c == 0 {
+                            continue;
+                        }
+                        let s = [opts[0][a], opts[1][b], opts[2][c]];
+                        let code = (s[0] + 1) + 3 * (s[1] + 1) + 9 * (s[2] + 1);
+                        out.push((i as u32, code as u8));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The centres followed by their images within `width` (see
+    /// [`Region::images`]) and, for each entry, its grain and shift code.
+    pub(crate) fn extended(
+        &self,
+        centres: &[Vector3<f64>],
+        width: f64,
+    ) -> (Vec<Vector3<f64>>, Vec<u32>, Vec<u8>) {
+        let images = self.images(centres, width);
+        let n = centres.len();
+        let mut c = Vec::with_capacity(n + images.len());
+        let mut real = Vec::with_capacity(n + images.len());
+        let mut code = Vec::with_capacity(n + images.len());
+        c.extend_from_slice(centres);
+        real.extend(0..n as u32);
+        code.resize(n, NO_SHIFT);
+        for (i, s) in images {
+            c.push(centres[i as usize] + self.shift(s));
+            real.push(i);
+            code.push(s);
+        }
+        (c, real, code)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn images_cover_faces_edges_and_corners_once() {
+        let b = Boundary::Periodic {
+            min: Point3::new(0.0, 0.0, 0.0),
+            max: Point3::new(10.0, 20.0, 30.0),
+        };
+        let r = Region::new(&b);
+        assert_eq!(r.shift(NO_SHIFT), Vector3::zeros());
+        let centres = [
+            Vector3::new(5.0, 10.0, 15.0), // interior: none
+            Vector3::new(0.5, 10.0, 15.0), // one face: +x
+            Vector3::new(9.5, 19.5, 15.0), // edge: -x, -y, -x-y
+            Vector3::new(0.5, 0.5, 29.5),  // corner: 7
+        ];
+        let im = r.images(&centres, 1.0);
+        let count = |i: u32| im.iter().filter(|x| x.0 == i).count();
+        assert_eq!((count(0), count(1), count(2), count(3)), (0, 1, 3, 7));
+        let one = im.iter().find(|x| x.0 == 1).map(|x| r.shift(x.1));
+        assert_eq!(one, Some(Vector3::new(10.0, 0.0, 0.0)));
+        for (i, s) in &im {
+            let p = centres[*i as usize] + r.shift(*s);
+            // every image lies within the width outside the cell
+            for k in 0..3 {
+                assert!(p[k] > -1.0 && p[k] < r.hi[k] + 1.0, "{p:?}");
+            }
+        }
+        let w = r.wrap(&Vector3::new(-0.5, 41.0, 30.0));
+        assert!((w - Vector3::new(9.5, 1.0, 0.0)).norm() < 1e-12, "{w:?}");
+    }
+
+    #[test]
+    fn walled_axes_get_no_images() {
+        let c = Container::Box {
+            min: Point3::origin(),
+            max: Point3::new(10.0, 10.0, 10.0),
+            periodic: [true, false],
+        };
+        let r = Region::of(&c);
+        let im = r.images(&[Vector3::new(0.5, 0.5, 0.5)], 1.0);
+        assert_eq!(im.len(), 1);
+        assert_eq!(r.shift(im[0].1), Vector3::new(10.0, 0.0, 0.0));
+        assert!(r.clearance(&Point3::new(5.0, 5.0, 0.25)) < 0.3);
+        let free = Boundary::Periodic {
+            min: Point3::origin(),
+            max: Point3::new(1.0, 1.0, 1.0),
+        };
+        assert_eq!(
+            Region::new(&free).clearance(&Point3::new(5.0, 5.0, 5.0)),
+            f64::INFINITY
+        );
+    }
+}
