@@ -324,6 +324,8 @@ const SEED_ROWS: [&str; 4] = [
     "volume_surface_ratio",
 ];
 
+/// The Markdown report: every configuration, Tables 4–5 beside the seed's,
+/// and the chosen configuration `outcomes[best]` in detail.
 fn report_md(
     outcomes: &[Outcome],
     best: usize,
@@ -344,6 +346,22 @@ fn report_md(
         material.description,
         rayon::current_num_threads()
     );
+    md_every_configuration(&mut md, outcomes, best);
+    // Tables 4–5 beside the seed's
+    for (title, table, pick) in [
+        ("Table 4 format: mean error (%)", &t4, 0usize),
+        ("Table 5 format: standard-deviation error (%)", &t5, 1usize),
+    ] {
+        md_seed_table(&mut md, title, table, pick, outcomes, best)?;
+    }
+    md_chosen(&mut md, &outcomes[best]);
+    md.push_str("Plots: `histogram_<parameter>.svg` (chosen configuration), `grading.svg`, `error_vs_time.svg`.\n");
+    Ok(md)
+}
+
+/// The table of every configuration: errors, KS distances, throughput,
+/// acceptance and cost; `outcomes[best]` marked as chosen.
+fn md_every_configuration(md: &mut String, outcomes: &[Outcome], best: usize) {
     md.push_str("## Every configuration\n\n| configuration | seed trial | mean err AR / D / R / V/S (%) | avg | std err AR / D / R / V/S (%) | avg | KS AR / D / R / V/S | max KS | accepted/s | ms per clone (CPU) | acceptance | level sets / clone | cost / clone |\n|---|---|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|\n");
     for o in outcomes {
         let s = &o.scores;
@@ -380,52 +398,65 @@ fn report_md(
             meets_and_cost(o, [f64::INFINITY; 3]).1
         );
     }
-    // Tables 4–5 beside the seed's
-    for (title, table, pick) in [
-        ("Table 4 format: mean error (%)", &t4, 0usize),
-        ("Table 5 format: standard-deviation error (%)", &t5, 1usize),
-    ] {
-        let _ = writeln!(
-            md,
-            "\n## {title}: ours (seed's trial grid) beside Medina 2018\n"
-        );
-        md.push_str("| parameter |");
-        for t in 0..=5 {
-            let _ = write!(md, " trial {t}: ours / seed |");
-        }
-        md.push_str(" chosen |\n|---|");
-        for _ in 0..=6 {
-            md.push_str("---|");
-        }
-        md.push('\n');
-        for (k, row) in SEED_ROWS.iter().chain(["average_error"].iter()).enumerate() {
-            let _ = write!(md, "| {row} |");
-            let pick_val = |o: &Outcome| -> f64 {
-                let v = if pick == 0 {
-                    &o.scores.mean_error_pct
-                } else {
-                    &o.scores.std_error_pct
-                };
-                if k < 4 {
-                    v[k]
-                } else if pick == 0 {
-                    o.scores.mean_error_avg_pct
-                } else {
-                    o.scores.std_error_avg_pct
-                }
-            };
-            for t in 0..=5 {
-                let ours = outcomes
-                    .iter()
-                    .find(|o| o.config.trial == Some(t) && !o.config.name.ends_with("seed-methods"))
-                    .map_or("—".into(), |o| format!("{:.2}", pick_val(o)));
-                let seed = table.number(k, &format!("trial_{t}"))?;
-                let _ = write!(md, " {ours} / {seed:.2} |");
-            }
-            let _ = writeln!(md, " {:.2} |", pick_val(&outcomes[best]));
-        }
+}
+
+/// One of Tables 4–5 in the seed's format (`pick` 0: mean errors, 1:
+/// standard-deviation errors): ours per seed trial beside Medina 2018's
+/// `table`, and the chosen configuration `outcomes[best]`.
+fn md_seed_table(
+    md: &mut String,
+    title: &str,
+    table: &validate::fixtures::Table,
+    pick: usize,
+    outcomes: &[Outcome],
+    best: usize,
+) -> anyhow::Result<()> {
+    let _ = writeln!(
+        md,
+        "\n## {title}: ours (seed's trial grid) beside Medina 2018\n"
+    );
+    md.push_str("| parameter |");
+    for t in 0..=5 {
+        let _ = write!(md, " trial {t}: ours / seed |");
     }
-    let b = &outcomes[best];
+    md.push_str(" chosen |\n|---|");
+    for _ in 0..=6 {
+        md.push_str("---|");
+    }
+    md.push('\n');
+    for (k, row) in SEED_ROWS.iter().chain(["average_error"].iter()).enumerate() {
+        let _ = write!(md, "| {row} |");
+        let pick_val = |o: &Outcome| -> f64 {
+            let v = if pick == 0 {
+                &o.scores.mean_error_pct
+            } else {
+                &o.scores.std_error_pct
+            };
+            if k < 4 {
+                v[k]
+            } else if pick == 0 {
+                o.scores.mean_error_avg_pct
+            } else {
+                o.scores.std_error_avg_pct
+            }
+        };
+        for t in 0..=5 {
+            let ours = outcomes
+                .iter()
+                .find(|o| o.config.trial == Some(t) && !o.config.name.ends_with("seed-methods"))
+                .map_or("—".into(), |o| format!("{:.2}", pick_val(o)));
+            let seed = table.number(k, &format!("trial_{t}"))?;
+            let _ = write!(md, " {ours} / {seed:.2} |");
+        }
+        let _ = writeln!(md, " {:.2} |", pick_val(&outcomes[best]));
+    }
+    Ok(())
+}
+
+/// The chosen configuration `b` in detail: scores, grading, throughput,
+/// candidates and rejections, stage times, steering map and roundness
+/// prediction.
+fn md_chosen(md: &mut String, b: &Outcome) {
     let _ = writeln!(
         md,
         "\n## Chosen configuration: `{}`\n\nAverage mean error **{:.2} %** (seed trial 4: 5.91 %), average standard-deviation error **{:.2} %** (seed: 23.08 %), largest KS **{:.3}**. Grading: parents Cu = {:.3}, Cc = {:.3}; clones Cu = {:.3}, Cc = {:.3}. Throughput {:.0} accepted clones/s on {} threads ({:.2} ms of CPU per clone), {:.0}× faster than the seed's 5 min per clone on one 4-core PC.\n",
@@ -496,8 +527,6 @@ fn report_md(
             c[0], c[1], c[2], m.roundness_prediction_sd, m.residual_sd[3],
         );
     }
-    md.push_str("Plots: `histogram_<parameter>.svg` (chosen configuration), `grading.svg`, `error_vs_time.svg`.\n");
-    Ok(md)
 }
 
 fn report_csv(outcomes: &[Outcome]) -> String {
@@ -656,6 +685,101 @@ fn meets_and_cost(o: &Outcome, targets: [f64; 3]) -> (bool, f64) {
     (meets, cost)
 }
 
+/// Index of the chosen configuration among `outcomes` under the accuracy
+/// `targets`.
+fn choose(outcomes: &[Outcome], targets: [f64; 3]) -> usize {
+    // the accuracy targets first (by default average mean error <= 2 %,
+    // average std error <= 10 %, every KS <= 0.10); among the
+    // configurations meeting them, the lowest deterministic cost per
+    // accepted clone (level sets + CANDIDATE_COST x candidates: the same
+    // on every machine; beyond the targets, error differences of a few
+    // tenths of a point are sampling noise at 500 clones, cost
+    // differences are not); then the lowest sum of the two averages (the
+    // seed's criterion over both tables), which alone ranks the
+    // configurations that miss the targets
+    outcomes
+        .iter()
+        .enumerate()
+        .min_by(|(_, a), (_, b)| {
+            let key = |o: &Outcome| {
+                let s = &o.scores;
+                let (meets, cost) = meets_and_cost(o, targets);
+                (
+                    !meets,
+                    if meets { cost } else { 0.0 },
+                    s.mean_error_avg_pct + s.std_error_avg_pct,
+                )
+            };
+            let (ka, kb) = (key(a), key(b));
+            ka.0.cmp(&kb.0)
+                .then(ka.1.total_cmp(&kb.1))
+                .then(ka.2.total_cmp(&kb.2))
+        })
+        .map_or(0, |(i, _)| i)
+}
+
+/// The report's closing paragraph (the parents, the targets and how many
+/// configurations meet them) and the configurations that failed.
+fn md_targets_and_failures(
+    md: &mut String,
+    material: &Material,
+    targets: [f64; 3],
+    outcomes: &[Outcome],
+    best: usize,
+    failed: &[String],
+) {
+    let _ = writeln!(
+        md,
+        "\nParents: {}. Targets: average mean error ≤ {} %, average standard-deviation error ≤ {} %, every KS ≤ {}; {} of {} configurations meet them{}. Ranking cost: level sets + {CANDIDATE_COST} × candidates per accepted clone.",
+        material.description,
+        targets[0],
+        targets[1],
+        targets[2],
+        outcomes
+            .iter()
+            .filter(|o| meets_and_cost(o, targets).0)
+            .count(),
+        outcomes.len(),
+        if meets_and_cost(&outcomes[best], targets).0 {
+            ""
+        } else {
+            " (none does: the chosen configuration has the lowest error sum)"
+        }
+    );
+    if !failed.is_empty() {
+        md.push_str("\n## Configurations that failed\n\n");
+        for f in failed {
+            let _ = writeln!(md, "* {f}");
+        }
+    }
+}
+
+/// Writes the report directory `dir`: `calibrate.md` (`md`),
+/// `calibrate.csv`, the plots, the parents' and the chosen clones' DNA and
+/// the clones' steering.
+fn write_report(
+    dir: &Path,
+    md: &str,
+    parents: &Parents,
+    outcomes: &[Outcome],
+    best: usize,
+) -> anyhow::Result<()> {
+    progress::write_atomic(&dir.join("calibrate.md"), md.as_bytes())?;
+    progress::write_atomic(&dir.join("calibrate.csv"), report_csv(outcomes).as_bytes())?;
+    write_plots(dir, parents.dna(), outcomes, best)?;
+    let mut buf = Vec::new();
+    parents.dna().write_csv(&mut buf)?;
+    progress::write_atomic(&dir.join("parents-dna.csv"), &buf)?;
+    let mut buf = Vec::new();
+    outcomes[best].dna.write_csv(&mut buf)?;
+    progress::write_atomic(&dir.join("clones-dna.csv"), &buf)?;
+    progress::write_atomic(
+        &dir.join("clones-steering.csv"),
+        outcomes[best].steering.as_bytes(),
+    )?;
+    Ok(())
+}
+
 impl Calibrate {
     /// The embedded Ottawa parents, or the user's.
     fn parents(&self) -> anyhow::Result<(Parents, Material, f64)> {
@@ -701,13 +825,9 @@ impl Calibrate {
         }
     }
 
-    pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
-        let start = Instant::now();
-        let (parents, material, prep_s) = self.parents()?;
-        eprintln!("{} parents in {prep_s:.1} s", parents.len());
-        if self.check {
-            return self.check(root, &parents);
-        }
+    /// The accuracy targets of the flags (average mean error, average
+    /// standard-deviation error, largest KS).
+    fn targets(&self) -> anyhow::Result<[f64; 3]> {
         for (name, v) in [
             ("--target-mean", self.target_mean),
             ("--target-std", self.target_std),
@@ -717,7 +837,12 @@ impl Calibrate {
                 bail!("{name} must be finite and positive, got {v}");
             }
         }
-        let targets = [self.target_mean, self.target_std, self.target_ks];
+        Ok([self.target_mean, self.target_std, self.target_ks])
+    }
+
+    /// The sweep's configurations, filtered by `--only` and with the flags'
+    /// overrides applied.
+    fn configs(&self) -> anyhow::Result<Vec<Config>> {
         let mut configs = sweep(self.seed);
         if let Some(only) = &self.only {
             let names: Vec<&str> = only.split(',').map(str::trim).collect();
@@ -737,6 +862,49 @@ impl Calibrate {
                 c.params.pilot_clones = k;
             }
         }
+        Ok(configs)
+    }
+
+    /// Writes the chosen configuration `b` where [`Self::config_path`] says
+    /// (or into the report directory `dir`), unless `--no-fixture` or a bare
+    /// `--only` run; returns the path written.
+    fn write_calibrated(
+        &self,
+        root: &Path,
+        dir: &Path,
+        b: &Outcome,
+        parents: usize,
+    ) -> anyhow::Result<Option<PathBuf>> {
+        let cal = Calibrated {
+            name: b.config.name.clone(),
+            params: b.config.params,
+            clones: self.clones,
+            parents,
+            scores: b.scores.clone(),
+            attempts: b.stats.attempts,
+        };
+        let text = cal.to_ron()? + "\n";
+        let written = if self.no_fixture || (self.only.is_some() && self.out.is_none()) {
+            None
+        } else {
+            let path = self
+                .config_path(root)
+                .unwrap_or_else(|| dir.join("calibrated.ron"));
+            progress::write_atomic(&path, text.as_bytes())?;
+            Some(path)
+        };
+        Ok(written)
+    }
+
+    pub(crate) fn run(self, root: &Path) -> anyhow::Result<()> {
+        let start = Instant::now();
+        let (parents, material, prep_s) = self.parents()?;
+        eprintln!("{} parents in {prep_s:.1} s", parents.len());
+        if self.check {
+            return self.check(root, &parents);
+        }
+        let targets = self.targets()?;
+        let configs = self.configs()?;
         let mut outcomes = Vec::new();
         let mut failed = Vec::new();
         let sweep_start = Instant::now();
@@ -753,96 +921,17 @@ impl Calibrate {
         if outcomes.is_empty() {
             bail!("every configuration failed:\n{}", failed.join("\n"));
         }
-        // the accuracy targets first (by default average mean error <= 2 %,
-        // average std error <= 10 %, every KS <= 0.10); among the
-        // configurations meeting them, the lowest deterministic cost per
-        // accepted clone (level sets + CANDIDATE_COST x candidates: the same
-        // on every machine; beyond the targets, error differences of a few
-        // tenths of a point are sampling noise at 500 clones, cost
-        // differences are not); then the lowest sum of the two averages (the
-        // seed's criterion over both tables), which alone ranks the
-        // configurations that miss the targets
-        let best = outcomes
-            .iter()
-            .enumerate()
-            .min_by(|(_, a), (_, b)| {
-                let key = |o: &Outcome| {
-                    let s = &o.scores;
-                    let (meets, cost) = meets_and_cost(o, targets);
-                    (
-                        !meets,
-                        if meets { cost } else { 0.0 },
-                        s.mean_error_avg_pct + s.std_error_avg_pct,
-                    )
-                };
-                let (ka, kb) = (key(a), key(b));
-                ka.0.cmp(&kb.0)
-                    .then(ka.1.total_cmp(&kb.1))
-                    .then(ka.2.total_cmp(&kb.2))
-            })
-            .map_or(0, |(i, _)| i);
+        let best = choose(&outcomes, targets);
         let dir = root.join(&self.report);
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         let mut md = report_md(&outcomes, best, &material, self.clones, prep_s)?;
-        let _ = writeln!(
-            md,
-            "\nParents: {}. Targets: average mean error ≤ {} %, average standard-deviation error ≤ {} %, every KS ≤ {}; {} of {} configurations meet them{}. Ranking cost: level sets + {CANDIDATE_COST} × candidates per accepted clone.",
-            material.description,
-            targets[0],
-            targets[1],
-            targets[2],
-            outcomes
-                .iter()
-                .filter(|o| meets_and_cost(o, targets).0)
-                .count(),
-            outcomes.len(),
-            if meets_and_cost(&outcomes[best], targets).0 {
-                ""
-            } else {
-                " (none does: the chosen configuration has the lowest error sum)"
-            }
-        );
-        if !failed.is_empty() {
-            md.push_str("\n## Configurations that failed\n\n");
-            for f in &failed {
-                let _ = writeln!(md, "* {f}");
-            }
-        }
-        progress::write_atomic(&dir.join("calibrate.md"), md.as_bytes())?;
-        progress::write_atomic(&dir.join("calibrate.csv"), report_csv(&outcomes).as_bytes())?;
-        write_plots(&dir, parents.dna(), &outcomes, best)?;
-        let mut buf = Vec::new();
-        parents.dna().write_csv(&mut buf)?;
-        progress::write_atomic(&dir.join("parents-dna.csv"), &buf)?;
-        let mut buf = Vec::new();
-        outcomes[best].dna.write_csv(&mut buf)?;
-        progress::write_atomic(&dir.join("clones-dna.csv"), &buf)?;
-        progress::write_atomic(
-            &dir.join("clones-steering.csv"),
-            outcomes[best].steering.as_bytes(),
-        )?;
+        md_targets_and_failures(&mut md, &material, targets, &outcomes, best, &failed);
+        write_report(&dir, &md, &parents, &outcomes, best)?;
         if !self.quiet {
             println!("{md}");
         }
         let b = &outcomes[best];
-        let cal = Calibrated {
-            name: b.config.name.clone(),
-            params: b.config.params,
-            clones: self.clones,
-            parents: parents.len(),
-            scores: b.scores.clone(),
-            attempts: b.stats.attempts,
-        };
-        let text = cal.to_ron()? + "\n";
-        let written = if self.no_fixture || (self.only.is_some() && self.out.is_none()) {
-            None
-        } else {
-            let path = self
-                .config_path(root)
-                .unwrap_or_else(|| dir.join("calibrated.ron"));
-            progress::write_atomic(&path, text.as_bytes())?;
-            Some(path)
-        };
+        let written = self.write_calibrated(root, &dir, b, parents.len())?;
         println!(
             "Calibrated {} parents: {} configurations × {} clones in {sweep_s:.1} s (parents {prep_s:.1} s); chosen `{}`: average mean error {:.2} %, average std error {:.2} %, max KS {:.3}, {:.0} accepted clones/s; report in {}{} ({:.1} s in all).",
             parents.len(),

@@ -142,12 +142,28 @@ fn column(rows: &[&Row], d: Descriptor) -> Vec<f64> {
     rows.iter().map(|r| r.values[i]).collect()
 }
 
+/// The Markdown report: DNA per shipped set, the Ottawa sets against NIST's
+/// geometry table, their medians beside NIST's, and the default parents'
+/// correlation matrix beside Medina 2018, Table 1.
 fn report(rows: &[Row], geom: &[(String, Geom)]) -> anyhow::Result<String> {
     let mut md = String::from("# Morphological DNA of the shipped VCCTL grains\n\n");
     let _ = writeln!(
         md,
         "Level sets of 45³ nodes over each grain's bounding cube (×1.1); descriptors as defined in `morph-dna` (`measure` module docs).\n"
     );
+    md_sets(&mut md, rows)?;
+    // Ottawa vs NIST geometry table
+    for set in ["ottawa", "ottawa-random"] {
+        md_against_nist(&mut md, rows, geom, set)?;
+    }
+    // representativeness: medians beside NIST's, for each Ottawa set
+    md_medians(&mut md)?;
+    md_correlation(&mut md, rows)?;
+    Ok(md)
+}
+
+/// Mean ± standard deviation of the main descriptors of every shipped set.
+fn md_sets(md: &mut String, rows: &[Row]) -> anyhow::Result<()> {
     md.push_str("| set | grains | aspect ratio S/L | roundness | sphericity | convexity | V/A (scan units) |\n|---|---:|---|---|---|---|---|\n");
     for set in SETS {
         let sel: Vec<&Row> = rows.iter().filter(|r| r.set == set).collect();
@@ -170,73 +186,86 @@ fn report(rows: &[Row], geom: &[(String, Geom)]) -> anyhow::Result<String> {
             ms(Descriptor::VolumeSurfaceRatio)?
         );
     }
-    // Ottawa vs NIST geometry table
-    for set in ["ottawa", "ottawa-random"] {
-        let ottawa: Vec<&Row> = rows.iter().filter(|r| r.set == set).collect();
-        let mut pairs = Vec::new();
-        for r in &ottawa {
-            if let Some((_, g)) = geom
-                .iter()
-                .find(|(n, _)| n.trim_end_matches(".dat") == r.grain)
-            {
-                pairs.push((*r, g));
-            }
+    Ok(())
+}
+
+/// The Ottawa set `set` against NIST's geometry table: correlations of the
+/// caliper ratios and sphericity, volume and area errors.
+fn md_against_nist(
+    md: &mut String,
+    rows: &[Row],
+    geom: &[(String, Geom)],
+    set: &str,
+) -> anyhow::Result<()> {
+    let ottawa: Vec<&Row> = rows.iter().filter(|r| r.set == set).collect();
+    let mut pairs = Vec::new();
+    for r in &ottawa {
+        if let Some((_, g)) = geom
+            .iter()
+            .find(|(n, _)| n.trim_end_matches(".dat") == r.grain)
+        {
+            pairs.push((*r, g));
         }
-        let ours = |d: Descriptor| -> Vec<f64> {
-            column(&pairs.iter().map(|(r, _)| *r).collect::<Vec<_>>(), d)
-        };
-        let l_over_s: Vec<f64> = ours(Descriptor::AspectRatio)
-            .iter()
-            .map(|a| 1.0 / a)
-            .collect();
-        let i_over_s: Vec<f64> = ours(Descriptor::Flatness).iter().map(|f| 1.0 / f).collect();
-        let nist_lt: Vec<f64> = pairs.iter().map(|(_, g)| g.l_over_t).collect();
-        let nist_wt: Vec<f64> = pairs.iter().map(|(_, g)| g.w_over_t).collect();
-        let sph = ours(Descriptor::Sphericity);
-        let nist_sph: Vec<f64> = pairs.iter().map(|(_, g)| 1.0 / g.norm_surf_area).collect();
-        let vol = ours(Descriptor::Volume);
-        let area = ours(Descriptor::SurfaceArea);
-        let vol_err: Vec<f64> = pairs
-            .iter()
-            .zip(&vol)
-            .map(|((_, g), v)| v / (g.volume * 1e6) - 1.0)
-            .collect();
-        let area_err: Vec<f64> = pairs
-            .iter()
-            .zip(&area)
-            .map(|((_, g), a)| a / (g.area * 1e4) - 1.0)
-            .collect();
+    }
+    let ours = |d: Descriptor| -> Vec<f64> {
+        column(&pairs.iter().map(|(r, _)| *r).collect::<Vec<_>>(), d)
+    };
+    let l_over_s: Vec<f64> = ours(Descriptor::AspectRatio)
+        .iter()
+        .map(|a| 1.0 / a)
+        .collect();
+    let i_over_s: Vec<f64> = ours(Descriptor::Flatness).iter().map(|f| 1.0 / f).collect();
+    let nist_lt: Vec<f64> = pairs.iter().map(|(_, g)| g.l_over_t).collect();
+    let nist_wt: Vec<f64> = pairs.iter().map(|(_, g)| g.w_over_t).collect();
+    let sph = ours(Descriptor::Sphericity);
+    let nist_sph: Vec<f64> = pairs.iter().map(|(_, g)| 1.0 / g.norm_surf_area).collect();
+    let vol = ours(Descriptor::Volume);
+    let area = ours(Descriptor::SurfaceArea);
+    let vol_err: Vec<f64> = pairs
+        .iter()
+        .zip(&vol)
+        .map(|((_, g), v)| v / (g.volume * 1e6) - 1.0)
+        .collect();
+    let area_err: Vec<f64> = pairs
+        .iter()
+        .zip(&area)
+        .map(|((_, g), a)| a / (g.area * 1e4) - 1.0)
+        .collect();
+    let _ = writeln!(
+        md,
+        "\n## Ottawa sand `{set}` ({} grains) against NIST's geometry table\n",
+        pairs.len()
+    );
+    md.push_str("| ours | NIST | Pearson | Spearman |\n|---|---|---:|---:|\n");
+    for (a, b, an, bn) in [
+        (&l_over_s, &nist_lt, "L/S (1 / aspect ratio)", "L/T"),
+        (&i_over_s, &nist_wt, "I/S (1 / flatness)", "W/T"),
+        (&sph, &nist_sph, "Wadell sphericity", "1 / norm_surf_area"),
+    ] {
         let _ = writeln!(
             md,
-            "\n## Ottawa sand `{set}` ({} grains) against NIST's geometry table\n",
-            pairs.len()
-        );
-        md.push_str("| ours | NIST | Pearson | Spearman |\n|---|---|---:|---:|\n");
-        for (a, b, an, bn) in [
-            (&l_over_s, &nist_lt, "L/S (1 / aspect ratio)", "L/T"),
-            (&i_over_s, &nist_wt, "I/S (1 / flatness)", "W/T"),
-            (&sph, &nist_sph, "Wadell sphericity", "1 / norm_surf_area"),
-        ] {
-            let _ = writeln!(
-                md,
-                "| {an} | {bn} | {:.3} | {:.3} |",
-                morph_dna::stats::pearson(a, b)?,
-                morph_dna::stats::spearman(a, b)?
-            );
-        }
-        let stat = |v: &[f64]| -> String {
-            let m = v.iter().sum::<f64>() / v.len() as f64;
-            let worst = v.iter().fold(0.0f64, |w, x| w.max(x.abs()));
-            format!("mean {:+.2} %, worst |{:.2}| %", 100.0 * m, 100.0 * worst)
-        };
-        let _ = writeln!(
-            md,
-            "\nLevel-set (45³) volume vs NIST volume: {}; area vs NIST area: {}. NIST integrates the SH surface itself; the level set smooths roughness below its spacing, so its area is lower.\n",
-            stat(&vol_err),
-            stat(&area_err)
+            "| {an} | {bn} | {:.3} | {:.3} |",
+            morph_dna::stats::pearson(a, b)?,
+            morph_dna::stats::spearman(a, b)?
         );
     }
-    // representativeness: medians beside NIST's, for each Ottawa set
+    let stat = |v: &[f64]| -> String {
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        let worst = v.iter().fold(0.0f64, |w, x| w.max(x.abs()));
+        format!("mean {:+.2} %, worst |{:.2}| %", 100.0 * m, 100.0 * worst)
+    };
+    let _ = writeln!(
+        md,
+        "\nLevel-set (45³) volume vs NIST volume: {}; area vs NIST area: {}. NIST integrates the SH surface itself; the level set smooths roughness below its spacing, so its area is lower.\n",
+        stat(&vol_err),
+        stat(&area_err)
+    );
+    Ok(())
+}
+
+/// Shape medians of each Ottawa set beside NIST's, for the same grains and
+/// for the population.
+fn md_medians(md: &mut String) -> anyhow::Result<()> {
     md.push_str("\n## Are the Ottawa parents representative? Medians beside NIST's\n\n");
     md.push_str("NIST's length L, width W and thickness T are calipers (L the longest surface-to-surface distance, W the longest perpendicular to L, T the longest perpendicular to both). Like with like, our caliper ratios are the extents along the principal axes of inertia: flatness S/I = minor/intermediate extent (NIST T/W), elongation I/L = intermediate/major extent (NIST W/L). Our `flatness`/`elongation` descriptors use the inertia-equivalent ellipsoid's axes instead (same for an ellipsoid, smoother for rough grains) and are shown beside. Population: NIST's medians over all 2,201 Ottawa grains.\n\n");
     md.push_str("| set | grains | caliper S/I (ours) | NIST T/W, same grains | population T/W | caliper I/L (ours) | NIST W/L, same grains | population W/L | inertia S/I | inertia I/L |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -261,6 +290,12 @@ fn report(rows: &[Row], geom: &[(String, Geom)]) -> anyhow::Result<String> {
             m.elongation
         );
     }
+    Ok(())
+}
+
+/// The default parents' Pearson correlation matrix beside Medina 2018,
+/// Table 1 (a regolith simulant).
+fn md_correlation(md: &mut String, rows: &[Row]) -> anyhow::Result<()> {
     let ottawa: Vec<&Row> = rows
         .iter()
         .filter(|r| format!("vcctl/{}", r.set) == validate::grains::DEFAULT_PARENTS)
@@ -295,7 +330,7 @@ fn report(rows: &[Row], geom: &[(String, Geom)]) -> anyhow::Result<String> {
         md.push('\n');
     }
     md.push_str("\nThe seed's parents are a regolith simulant, ours Ottawa sand: the signs and magnitudes need not agree.\n");
-    Ok(md)
+    Ok(())
 }
 
 fn compare(committed: &str, fresh: &str) -> anyhow::Result<()> {

@@ -83,44 +83,102 @@ fn escape(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
+/// `x` in axis units: log10 on a log-x axis.
+fn axis_x(log_x: bool, x: f64) -> f64 {
+    if log_x { x.max(1e-300).log10() } else { x }
+}
+
+/// Page size, margins and data ranges of a chart, and its coordinate maps.
+struct Frame {
+    /// Page width and height (px).
+    w: f64,
+    h: f64,
+    /// Left, right, top and bottom margins (px).
+    ml: f64,
+    mr: f64,
+    mt: f64,
+    mb: f64,
+    log_x: bool,
+    /// Padded x range, in axis units (log10 on a log-x axis).
+    x0: f64,
+    x1: f64,
+    /// Padded y range.
+    y0: f64,
+    y1: f64,
+}
+
+impl Frame {
+    /// The frame of `chart`: margins (wider on the right for point labels)
+    /// and the padded range of its finite (and, on a log-x axis, positive-x)
+    /// points.
+    fn new(chart: &Chart) -> Self {
+        let (w, h) = (640.0, 420.0);
+        let labelled = chart.series.iter().any(|s| !s.point_labels.is_empty());
+        let (ml, mr, mt, mb) = (70.0, if labelled { 150.0 } else { 20.0 }, 40.0, 55.0);
+        let tx = |x: f64| axis_x(chart.log_x, x);
+        let pts: Vec<(f64, f64)> = chart
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().copied())
+            .filter(|(x, y)| x.is_finite() && y.is_finite() && (!chart.log_x || *x > 0.0))
+            .collect();
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64, 0.0f64);
+        for (x, y) in &pts {
+            x0 = x0.min(tx(*x));
+            x1 = x1.max(tx(*x));
+            y0 = y0.min(*y);
+            y1 = y1.max(*y);
+        }
+        if x1.partial_cmp(&x0) != Some(std::cmp::Ordering::Greater) {
+            x0 -= 0.5;
+            x1 += 0.5;
+        }
+        if y1.partial_cmp(&y0) != Some(std::cmp::Ordering::Greater) {
+            y1 = y0 + 1.0;
+        }
+        let pad = 0.05 * (x1 - x0);
+        let (x0, x1) = (x0 - pad, x1 + pad);
+        let y1 = y1 + 0.08 * (y1 - y0);
+        Self {
+            w,
+            h,
+            ml,
+            mr,
+            mt,
+            mb,
+            log_x: chart.log_x,
+            x0,
+            x1,
+            y0,
+            y1,
+        }
+    }
+
+    /// `x` in axis units.
+    fn tx(&self, x: f64) -> f64 {
+        axis_x(self.log_x, x)
+    }
+
+    /// Page x of the data value `x`.
+    fn px(&self, x: f64) -> f64 {
+        self.pxt(self.tx(x))
+    }
+
+    /// Page x of `t` in axis units.
+    fn pxt(&self, t: f64) -> f64 {
+        self.ml + (t - self.x0) / (self.x1 - self.x0) * (self.w - self.ml - self.mr)
+    }
+
+    /// Page y of the data value `y`.
+    fn py(&self, y: f64) -> f64 {
+        self.h - self.mb - (y - self.y0) / (self.y1 - self.y0) * (self.h - self.mt - self.mb)
+    }
+}
+
 /// Renders `chart` as a standalone SVG document.
 pub(crate) fn render(chart: &Chart) -> String {
-    let (w, h) = (640.0, 420.0);
-    let labelled = chart.series.iter().any(|s| !s.point_labels.is_empty());
-    let (ml, mr, mt, mb) = (70.0, if labelled { 150.0 } else { 20.0 }, 40.0, 55.0);
-    let tx = |x: f64| {
-        if chart.log_x {
-            x.max(1e-300).log10()
-        } else {
-            x
-        }
-    };
-    let pts: Vec<(f64, f64)> = chart
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().copied())
-        .filter(|(x, y)| x.is_finite() && y.is_finite() && (!chart.log_x || *x > 0.0))
-        .collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64, 0.0f64);
-    for (x, y) in &pts {
-        x0 = x0.min(tx(*x));
-        x1 = x1.max(tx(*x));
-        y0 = y0.min(*y);
-        y1 = y1.max(*y);
-    }
-    if x1.partial_cmp(&x0) != Some(std::cmp::Ordering::Greater) {
-        x0 -= 0.5;
-        x1 += 0.5;
-    }
-    if y1.partial_cmp(&y0) != Some(std::cmp::Ordering::Greater) {
-        y1 = y0 + 1.0;
-    }
-    let pad = 0.05 * (x1 - x0);
-    let (x0, x1) = (x0 - pad, x1 + pad);
-    let y1 = y1 + 0.08 * (y1 - y0);
-    let px = |x: f64| ml + (tx(x) - x0) / (x1 - x0) * (w - ml - mr);
-    let pxt = |t: f64| ml + (t - x0) / (x1 - x0) * (w - ml - mr);
-    let py = |y: f64| h - mb - (y - y0) / (y1 - y0) * (h - mt - mb);
+    let f = Frame::new(chart);
+    let (w, h, ml, mr, mt, mb) = (f.w, f.h, f.ml, f.mr, f.mt, f.mb);
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -139,6 +197,19 @@ pub(crate) fn render(chart: &Chart) -> String {
         w - ml - mr,
         h - mt - mb
     );
+    write_axes(&mut s, chart, &f);
+    for (k, series) in chart.series.iter().enumerate() {
+        write_series(&mut s, &f, k, series);
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// Grid lines and tick labels of both axes (decades 1-2-5 on a log-x axis),
+/// and the axis labels.
+fn write_axes(s: &mut String, chart: &Chart, f: &Frame) {
+    let (w, h, ml, mr, mt, mb) = (f.w, f.h, f.ml, f.mr, f.mt, f.mb);
+    let (x0, x1) = (f.x0, f.x1);
     let xticks: Vec<(f64, String)> = if chart.log_x {
         let (a, b) = (x0.floor() as i32, x1.ceil() as i32);
         (a..=b)
@@ -153,7 +224,7 @@ pub(crate) fn render(chart: &Chart) -> String {
             .collect()
     };
     for (t, label) in xticks {
-        let x = pxt(t);
+        let x = f.pxt(t);
         let _ = writeln!(
             s,
             r##"<line x1="{x:.1}" y1="{}" x2="{x:.1}" y2="{mt}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{label}</text>"##,
@@ -161,8 +232,8 @@ pub(crate) fn render(chart: &Chart) -> String {
             h - mb + 16.0
         );
     }
-    for v in nice_ticks(y0, y1, 6) {
-        let y = py(v);
+    for v in nice_ticks(f.y0, f.y1, 6) {
+        let y = f.py(v);
         let _ = writeln!(
             s,
             r##"<line x1="{ml}" y1="{y:.1}" x2="{}" y2="{y:.1}" stroke="#ddd"/><text x="{}" y="{:.1}" text-anchor="end">{}</text>"##,
@@ -186,59 +257,60 @@ pub(crate) fn render(chart: &Chart) -> String {
         mt + (h - mt - mb) / 2.0,
         escape(&chart.y_label)
     );
-    for (k, series) in chart.series.iter().enumerate() {
-        let c = COLOURS[k % COLOURS.len()];
-        let visible: Vec<(usize, (f64, f64))> = series
-            .points
-            .iter()
-            .copied()
-            .enumerate()
-            .filter(|(_, (x, y))| x.is_finite() && y.is_finite() && (!chart.log_x || *x > 0.0))
-            .collect();
-        match series.style {
-            Style::Line => {
-                let path: Vec<String> = visible
-                    .iter()
-                    .map(|(_, (x, y))| format!("{:.1},{:.1}", px(*x), py(*y)))
-                    .collect();
+}
+
+/// The `k`-th series of a chart (its visible points as a polyline or as
+/// labelled markers) and its legend entry.
+fn write_series(s: &mut String, f: &Frame, k: usize, series: &Series) {
+    let c = COLOURS[k % COLOURS.len()];
+    let visible: Vec<(usize, (f64, f64))> = series
+        .points
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(_, (x, y))| x.is_finite() && y.is_finite() && (!f.log_x || *x > 0.0))
+        .collect();
+    match series.style {
+        Style::Line => {
+            let path: Vec<String> = visible
+                .iter()
+                .map(|(_, (x, y))| format!("{:.1},{:.1}", f.px(*x), f.py(*y)))
+                .collect();
+            let _ = writeln!(
+                s,
+                r#"<polyline fill="none" stroke="{c}" stroke-width="1.8" points="{}"/>"#,
+                path.join(" ")
+            );
+        }
+        Style::Markers => {
+            for (i, (x, y)) in &visible {
                 let _ = writeln!(
                     s,
-                    r#"<polyline fill="none" stroke="{c}" stroke-width="1.8" points="{}"/>"#,
-                    path.join(" ")
+                    r#"<circle cx="{:.1}" cy="{:.1}" r="4" fill="{c}"/>"#,
+                    f.px(*x),
+                    f.py(*y)
                 );
-            }
-            Style::Markers => {
-                for (i, (x, y)) in &visible {
+                if let Some(l) = series.point_labels.get(*i) {
                     let _ = writeln!(
                         s,
-                        r#"<circle cx="{:.1}" cy="{:.1}" r="4" fill="{c}"/>"#,
-                        px(*x),
-                        py(*y)
+                        r#"<text x="{:.1}" y="{:.1}" font-size="10" fill="{c}">{}</text>"#,
+                        f.px(*x) + 6.0,
+                        f.py(*y) - 4.0,
+                        escape(l)
                     );
-                    if let Some(l) = series.point_labels.get(*i) {
-                        let _ = writeln!(
-                            s,
-                            r#"<text x="{:.1}" y="{:.1}" font-size="10" fill="{c}">{}</text>"#,
-                            px(*x) + 6.0,
-                            py(*y) - 4.0,
-                            escape(l)
-                        );
-                    }
                 }
             }
         }
-        let ly = mt + 16.0 + 16.0 * k as f64;
-        let lx = w - mr - 120.0;
-        let _ = writeln!(
-            s,
-            r#"<rect x="{lx}" y="{}" width="12" height="4" fill="{c}"/><text x="{}" y="{ly}">{}</text>"#,
-            ly - 5.0,
-            lx + 18.0,
-            escape(&series.label)
-        );
     }
-    s.push_str("</svg>\n");
-    s
+    let ly = f.mt + 16.0 + 16.0 * k as f64;
+    let lx = f.w - f.mr - 120.0;
+    let _ = writeln!(
+        s,
+        r#"<rect x="{lx}" y="{}" width="12" height="4" fill="{c}"/><text x="{}" y="{ly}">{}</text>"#,
+        ly - 5.0,
+        lx + 18.0,
+        escape(&series.label)
+    );
 }
 
 /// Density histogram of `x` on `bins` bins over `[lo, hi]` as a step line.

@@ -29,7 +29,20 @@ const ALLOWED: &[(&str, &[&str])] = &[
         "packer-grains",
         &["packer-spheres", "packer-quadtree", "levelset"],
     ),
-    // layer 3
+    // layer 3: the specimen pipeline on the cloner and the packers
+    (
+        "specimen",
+        &[
+            "levelset",
+            "sph-harmonics",
+            "morph-dna",
+            "cloner",
+            "packer-quadtree",
+            "packer-spheres",
+            "packer-grains",
+        ],
+    ),
+    // layer 4
     (
         "validate",
         &[
@@ -41,9 +54,10 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "packer-contact",
             "packer-spheres",
             "packer-grains",
+            "specimen",
         ],
     ),
-    // layer 4
+    // layer 5
     (
         "xtask",
         &[
@@ -55,6 +69,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "packer-contact",
             "packer-spheres",
             "packer-grains",
+            "specimen",
             "validate",
         ],
     ),
@@ -70,6 +85,7 @@ const LIBRARIES: &[&str] = &[
     "packer-contact",
     "packer-spheres",
     "packer-grains",
+    "specimen",
     "validate",
 ];
 

@@ -730,6 +730,105 @@ impl CloneModel {
         )
     }
 
+    /// Predicted-roundness passes (`Params::roundness_predictions`): re-steers
+    /// `cand` before any level set while the roundness predicted from its
+    /// surface DNA and inscribed radius misses its target by more than the
+    /// margin (a fraction of the tolerance `t`).
+    fn predicted_roundness_passes(
+        &self,
+        cand: &mut Candidate,
+        t: f64,
+        pred: [f64; 3],
+        s: &mut Scratch,
+        stats: &mut RunStats,
+        clock: &dyn Clock,
+    ) {
+        for _ in 0..self.params.roundness_predictions {
+            let t0 = clock.now_ns();
+            let ins = self.geom.inscribed_radius(&cand.radii);
+            stats.times.quality_ns += clock.now_ns() - t0;
+            let Some(ins) = ins else { break };
+            let predicted =
+                pred[0] + pred[1] * cand.surface.roundness + pred[2] * ins / cand.surface.r_min;
+            let miss = predicted - cand.targets.roundness;
+            // (a NaN miss ends the passes too)
+            let margin = self.params.roundness_prediction_margin * t;
+            if miss.abs().partial_cmp(&margin) != Some(std::cmp::Ordering::Greater) {
+                break;
+            }
+            stats.roundness_predictions += 1;
+            // a pass that fails (quality control, polishing) keeps the
+            // candidate as it was
+            match self.resteer(cand, miss / pred[1], s, stats, clock) {
+                Ok(c) => *cand = c,
+                Err(_) => break,
+            }
+        }
+    }
+
+    /// The candidate's level set and, with a roundness tolerance
+    /// `check_roundness`, its measured roundness checked against the target,
+    /// with up to `Params::roundness_repairs` re-steered repairs of `cand`.
+    /// Returns the level set (inside its measurement once measured) and the
+    /// measured roundness.
+    fn checked_level_set(
+        &self,
+        cand: &mut Candidate,
+        check_roundness: Option<f64>,
+        s: &mut Scratch,
+        stats: &mut RunStats,
+        clock: &dyn Clock,
+    ) -> std::result::Result<(Held, Option<f64>), Reject> {
+        let mut repairs = 0;
+        loop {
+            let t0 = clock.now_ns();
+            let g = self.rasterise(&cand.radii);
+            let t1 = clock.now_ns();
+            stats.times.rasterise_ns += t1 - t0;
+            stats.level_sets += 1;
+            let Ok(g) = g else {
+                break Err(Reject::Degenerate);
+            };
+            let Some(t) = check_roundness else {
+                break Ok((Held::Grid(g), None));
+            };
+            // the roundness check first, on roundness alone (morph-dna
+            // computes each descriptor identically alone or in a set),
+            // so a rejected clone does not pay for the volume pass; the
+            // measurement keeps the surface it extracted for the rest
+            let Ok(mut m) = Measurement::owned(g, &MeasureParams::default()) else {
+                break Err(Reject::Degenerate);
+            };
+            let r = m.get(&[Descriptor::Roundness]);
+            stats.times.measure_ns += clock.now_ns() - t1;
+            let r = match r {
+                Ok(r) => r[0],
+                Err(_) => break Err(Reject::Degenerate),
+            };
+            let miss = r - cand.targets.roundness;
+            if miss.abs() <= t {
+                break Ok((Held::Measured(Box::new(m)), Some(r)));
+            }
+            if repairs == self.params.roundness_repairs {
+                break Err(Reject::MeasuredRoundness);
+            }
+            // re-steer: polish the same raw field again toward a surface
+            // roundness moved against the miss (through the steering
+            // map's slope), then quality control and measure again
+            repairs += 1;
+            stats.roundness_repairs += 1;
+            let slope = self.steering_map().slope[3];
+            let shift = miss / if slope > 0.1 { slope } else { 1.0 };
+            match self.resteer(cand, shift, s, stats, clock) {
+                Ok(c) => *cand = c,
+                Err(r) => break Err(r),
+            }
+        }
+    }
+
+    /// The clone of `index` in `mode` with the `outputs` asked: candidates
+    /// (stages 1–4), predicted-roundness passes, the checked level set and the
+    /// DNA, until one is accepted or `max_attempts` candidates are spent.
     pub(crate) fn clone_with(
         &self,
         index: u64,
@@ -770,79 +869,12 @@ impl CloneModel {
                 _ => None,
             };
             let measure_dna = outputs.dna || check_roundness.is_some();
-            // predicted-roundness passes: re-steer before any level set while
-            // the prediction misses by more than the margin (a fraction of the
-            // tolerance)
             if let (Some(t), Some(pred)) = (check_roundness, self.map.roundness_prediction) {
-                for _ in 0..self.params.roundness_predictions {
-                    let t0 = clock.now_ns();
-                    let ins = self.geom.inscribed_radius(&cand.radii);
-                    stats.times.quality_ns += clock.now_ns() - t0;
-                    let Some(ins) = ins else { break };
-                    let predicted = pred[0]
-                        + pred[1] * cand.surface.roundness
-                        + pred[2] * ins / cand.surface.r_min;
-                    let miss = predicted - cand.targets.roundness;
-                    // (a NaN miss ends the passes too)
-                    let margin = self.params.roundness_prediction_margin * t;
-                    if miss.abs().partial_cmp(&margin) != Some(std::cmp::Ordering::Greater) {
-                        break;
-                    }
-                    stats.roundness_predictions += 1;
-                    // a pass that fails (quality control, polishing) keeps the
-                    // candidate as it was
-                    match self.resteer(&cand, miss / pred[1], &mut s, &mut stats, clock) {
-                        Ok(c) => cand = c,
-                        Err(_) => break,
-                    }
-                }
+                self.predicted_roundness_passes(&mut cand, t, pred, &mut s, &mut stats, clock);
             }
             if outputs.level_set || measure_dna {
-                let mut repairs = 0;
-                let g = loop {
-                    let t0 = clock.now_ns();
-                    let g = self.rasterise(&cand.radii);
-                    let t1 = clock.now_ns();
-                    stats.times.rasterise_ns += t1 - t0;
-                    stats.level_sets += 1;
-                    let Ok(g) = g else {
-                        break Err(Reject::Degenerate);
-                    };
-                    let Some(t) = check_roundness else {
-                        break Ok((Held::Grid(g), None));
-                    };
-                    // the roundness check first, on roundness alone (morph-dna
-                    // computes each descriptor identically alone or in a set),
-                    // so a rejected clone does not pay for the volume pass; the
-                    // measurement keeps the surface it extracted for the rest
-                    let Ok(mut m) = Measurement::owned(g, &MeasureParams::default()) else {
-                        break Err(Reject::Degenerate);
-                    };
-                    let r = m.get(&[Descriptor::Roundness]);
-                    stats.times.measure_ns += clock.now_ns() - t1;
-                    let r = match r {
-                        Ok(r) => r[0],
-                        Err(_) => break Err(Reject::Degenerate),
-                    };
-                    let miss = r - cand.targets.roundness;
-                    if miss.abs() <= t {
-                        break Ok((Held::Measured(Box::new(m)), Some(r)));
-                    }
-                    if repairs == self.params.roundness_repairs {
-                        break Err(Reject::MeasuredRoundness);
-                    }
-                    // re-steer: polish the same raw field again toward a surface
-                    // roundness moved against the miss (through the steering
-                    // map's slope), then quality control and measure again
-                    repairs += 1;
-                    stats.roundness_repairs += 1;
-                    let slope = self.steering_map().slope[3];
-                    let shift = miss / if slope > 0.1 { slope } else { 1.0 };
-                    match self.resteer(&cand, shift, &mut s, &mut stats, clock) {
-                        Ok(c) => cand = c,
-                        Err(r) => break Err(r),
-                    }
-                };
+                let g =
+                    self.checked_level_set(&mut cand, check_roundness, &mut s, &mut stats, clock);
                 let (held, roundness) = match g {
                     Ok(v) => v,
                     Err(r) => {
@@ -851,23 +883,12 @@ impl CloneModel {
                     }
                 };
                 let held = if measure_dna && (outputs.dna || roundness.is_none()) {
-                    let t1 = clock.now_ns();
-                    // the roundness and the surface are reused when the check
-                    // measured them
-                    let m = match held {
-                        Held::Measured(m) => Ok(m),
-                        Held::Grid(g) => {
-                            Measurement::owned(g, &MeasureParams::default()).map(Box::new)
-                        }
-                    };
-                    let d = m.and_then(|mut m| m.get(&DNA).map(|d| (d, m)));
-                    stats.times.measure_ns += clock.now_ns() - t1;
-                    match d {
-                        Ok((d, m)) => {
+                    match measure_held_dna(held, &mut stats, clock) {
+                        Some((d, m)) => {
                             dna = Some(d);
                             Held::Measured(m)
                         }
-                        Err(_) => {
+                        None => {
                             stats.rejections.degenerate += 1;
                             continue;
                         }
@@ -944,6 +965,23 @@ impl CloneModel {
         }
         Ok(Run { clones, stats })
     }
+}
+
+/// The DNA of a clone's level set, reusing the roundness and the surface
+/// when the roundness check measured them; `None` for a degenerate level set.
+fn measure_held_dna(
+    held: Held,
+    stats: &mut RunStats,
+    clock: &dyn Clock,
+) -> Option<(Vec<f64>, Box<Measurement<'static>>)> {
+    let t1 = clock.now_ns();
+    let m = match held {
+        Held::Measured(m) => Ok(m),
+        Held::Grid(g) => Measurement::owned(g, &MeasureParams::default()).map(Box::new),
+    };
+    let d = m.and_then(|mut m| m.get(&DNA).map(|d| (d, m)));
+    stats.times.measure_ns += clock.now_ns() - t1;
+    d.ok()
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! P2 1.05, P3 0.0094, P4 3.90, P5 172.30 particles/s. P5's preset uses
 //! the approximate wrappers; `P5-newton` times the exact clusters.
 //!
-//! `cargo bench -p packer-quadtree --bench pic` (P4/P5 take seconds per
+//! `cargo bench -p packer-contact --bench pic` (P4/P5 take seconds per
 //! packing; `-- P2` selects one row).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};

@@ -4,7 +4,7 @@
 //! radii uniform in [0.4, 0.45]) in a walled box and in a box periodic in x
 //! and y. Criterion's throughput is the sphere count (spheres/s).
 //!
-//! `cargo bench -p packer-quadtree --bench metrics3d`.
+//! `cargo bench -p packer-spheres --bench metrics3d`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{Point3, Vector3};

@@ -6,6 +6,8 @@
 
 use std::fmt::Write as _;
 
+use rayon::prelude::*;
+
 use cloner::{Parents, Run, TABLES_4_5, score};
 use morph_dna::{Descriptor, GradingCurve, GradingInterpolation, GradingWeight};
 
@@ -131,6 +133,63 @@ pub(crate) fn write(
         ));
     }
     Ok(files)
+}
+
+/// The report's section on the clumps as delivered (after trimming): their DNA, each
+/// union rasterised on its grain's own grid, and their union mass against the level sets.
+pub(crate) fn clump_dna_section(
+    spheres: &[Vec<(nalgebra::Point3<f64>, f64)>],
+    dna: &[Option<(levelset::GridSpec, Vec<f64>)>],
+    unions: &[levelset::MassProperties],
+    volumes: &[f64],
+    per_clump: usize,
+) -> anyhow::Result<String> {
+    let errors: Vec<Vec<f64>> = spheres
+        .par_iter()
+        .zip(dna)
+        .filter_map(|(s, d)| d.as_ref().map(|d| (s, d)))
+        .map(|(s, (spec, ours))| {
+            let union = levelset::Grid::from_fn(*spec, |p| {
+                s.iter()
+                    .fold(f64::INFINITY, |m, (c, r)| m.min((p - c).norm() - r))
+            })?;
+            let theirs = morph_dna::measure(
+                &union,
+                &::specimen::CLUMP_DNA,
+                &morph_dna::MeasureParams::default(),
+            )?;
+            Ok(theirs
+                .iter()
+                .zip(ours)
+                .map(|(c, l)| 100.0 * (c / l - 1.0))
+                .collect())
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let k = errors.len().max(1) as f64;
+    let mut md = format!(
+        "\n## Clumps as delivered ({per_clump} spheres per clump, after trimming)\n\n\
+         The body a clump DEM code moves, against the grain's level set: DNA of the sphere union \
+         rasterised on the grain's own grid (mean and mean |error| over {} clumps), and the \
+         union's mass properties (`levelset::union_mass_properties`).\n\n\
+         | parameter | mean error % | mean \\|error\\| % |\n| --- | --- | --- |\n",
+        errors.len()
+    );
+    for (i, d) in ::specimen::CLUMP_DNA.iter().enumerate() {
+        let mean = errors.iter().map(|e| e[i]).sum::<f64>() / k;
+        let abs = errors.iter().map(|e| e[i].abs()).sum::<f64>() / k;
+        md.push_str(&format!("| {} | {mean:+.2} | {abs:.2} |\n", d.name()));
+    }
+    let vol = unions
+        .iter()
+        .zip(volumes)
+        .map(|(u, v)| 100.0 * (u.volume / v - 1.0).abs())
+        .sum::<f64>()
+        / unions.len().max(1) as f64;
+    md.push_str(&format!(
+        "\nUnion volume (mass) against the level set: mean |error| {vol:.2} %. \
+         The masses and inertias given to LAMMPS, LIGGGHTS and Yade are the union's.\n"
+    ));
+    Ok(md)
 }
 
 fn mean_sd(x: &[f64]) -> (f64, f64) {

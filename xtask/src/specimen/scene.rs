@@ -267,15 +267,7 @@ pub(crate) enum Placement {
     BoundingSpheres,
 }
 
-/// The sphere packer's preset.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
-pub(crate) enum Preset {
-    /// `Pack3Params::default()`.
-    #[default]
-    Default,
-    /// `Pack3Params::dense()`.
-    Dense,
-}
+pub(crate) use ::specimen::place::Preset;
 
 /// What to write.
 #[derive(Debug, Clone, Deserialize)]
@@ -302,7 +294,7 @@ pub(crate) struct Outputs {
     /// LS-DEM test name: `InitState/positions_<NAME>.dat`, `rotations_<NAME>.dat`.
     pub(crate) lsdem_name: String,
     /// Contact constants of the DEM decks (Hertz–Mindlin, quartz; `dem.rs`).
-    pub(crate) material: super::dem::Material,
+    pub(crate) material: ::specimen::dem::Material,
     /// VTU of the marching-cubes surfaces of every placed grain.
     pub(crate) vtu: bool,
     /// Cells across the widest side of each grain's level-set box for its
@@ -327,7 +319,7 @@ impl Default for Outputs {
             clump: ClumpSpec::default(),
             density: QUARTZ_DENSITY,
             lsdem_name: "specimen".into(),
-            material: super::dem::Material::default(),
+            material: ::specimen::dem::Material::default(),
             vtu: false,
             vtu_resolution: 16,
             report: false,

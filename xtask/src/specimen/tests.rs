@@ -400,7 +400,7 @@ fn grains_stay_inside_their_bounding_spheres() {
         worst = worst.max(far / c.surface.r_max);
     }
     assert!(
-        worst <= super::place::BOUNDING_MARGIN,
+        worst <= ::specimen::place::BOUNDING_MARGIN,
         "a surface reaches {worst:.4} × the largest node radius"
     );
     println!("farthest surface point / largest node radius: {worst:.4}");
@@ -410,7 +410,7 @@ fn grains_stay_inside_their_bounding_spheres() {
 /// The binary VTU read back: every array's byte count matches its piece's
 /// counts, triangles index their own piece, every grain has a surface.
 fn vtu_reads_back(vtu: &str, grains: usize) {
-    let pieces = super::outputs::read_vtu(vtu).expect("the VTU reads back");
+    let pieces = super::vtu_read::read_vtu(vtu).expect("the VTU reads back");
     assert!(!pieces.is_empty());
     let mut ids = BTreeSet::new();
     for p in &pieces {
@@ -530,7 +530,7 @@ fn lsdem_quaternions_give_lsdem_the_pose_rotation() {
 fn base64_matches_rfc_4648_and_round_trips() {
     let enc = |b: &[u8]| {
         let mut s = String::new();
-        super::outputs::base64_into(b, &mut s);
+        ::specimen::outputs::base64_into(b, &mut s);
         s
     };
     // RFC 4648 § 10 test vectors
@@ -545,12 +545,15 @@ fn base64_matches_rfc_4648_and_round_trips() {
     ] {
         assert_eq!(enc(plain.as_bytes()), coded);
         assert_eq!(
-            super::outputs::base64_decode(coded).expect("decodes"),
+            ::specimen::outputs::base64_decode(coded).expect("decodes"),
             plain.as_bytes()
         );
     }
     let bytes: Vec<u8> = (0..=255u8).cycle().take(1000).collect();
-    assert_eq!(super::outputs::base64_decode(&enc(&bytes)), Some(bytes));
+    assert_eq!(
+        ::specimen::outputs::base64_decode(&enc(&bytes)),
+        Some(bytes)
+    );
 }
 
 /// Spheres of different grains that overlap, or cross a wall, are trimmed

@@ -7,7 +7,7 @@
 //! ([`check_spheres`]: its own cell grid, parry for meshes).
 //!
 //! Speed is not measured here (this crate has no clock): the criterion
-//! bench `packer-quadtree/benches/pack3d.rs` (10⁵ spheres) and the
+//! bench `packer-spheres/benches/pack3d.rs` (10⁵ spheres) and the
 //! `cargo xtask pack --dim 3` timing report (10⁶) do.
 
 use levelset::nalgebra::{Point3, Vector3};

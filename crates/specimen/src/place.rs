@@ -18,18 +18,28 @@
 //! roughly a third of their spheres' volume less than a dense grain
 //! packing would).
 
-use anyhow::bail;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use packer_grains::{GrainPackParams, GrainPackStats, StarGrain, container_for, pack_grains};
 use packer_spheres::{Container, Pack3Params};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use super::scene::Preset;
+use crate::error::{Error, Result};
+
+/// The sphere packer's preset (of the bounding spheres, or of the grain
+/// packer's skeleton).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
+pub enum Preset {
+    /// `Pack3Params::default()`.
+    #[default]
+    Default,
+    /// `Pack3Params::dense()`.
+    Dense,
+}
 
 /// Bounding radius = largest node radius × this margin (the level set
 /// between nodes is interpolated and may bulge slightly past the nodes).
-pub(crate) const BOUNDING_MARGIN: f64 = 1.05;
+pub const BOUNDING_MARGIN: f64 = 1.05;
 
 /// Stream offset of the rotations, so that they never share a stream with
 /// the cloner's (seed, index) streams.
@@ -38,33 +48,12 @@ const ROTATION_STREAM: u64 = 0x726f_7461_7465;
 /// What placement needs to know of one clone: its bounding radius about
 /// the clone frame's origin (major axis +x, minor +z).
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct ToPlace {
+pub struct ToPlace {
     /// Clone index (its random stream).
-    pub(crate) index: u64,
+    pub index: u64,
     /// Radius of a sphere about the clone frame's origin that holds the grain.
-    pub(crate) bounding_radius: f64,
+    pub bounding_radius: f64,
 }
-
-/// The container cannot take every clone (an auto-sized one grows on it).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct ContainerFull {
-    /// Clones to place.
-    pub(crate) clones: usize,
-    /// Bounding spheres that fitted.
-    pub(crate) placed: usize,
-}
-
-impl std::fmt::Display for ContainerFull {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "`container` cannot take all {} clones: their bounding spheres fill it after {}",
-            self.clones, self.placed
-        )
-    }
-}
-
-impl std::error::Error for ContainerFull {}
 
 /// Poses (clone frame → world) of every clone, in the order of `clones`.
 ///
@@ -72,14 +61,14 @@ impl std::error::Error for ContainerFull {}
 /// No clone; a container smaller than the largest clone's bounding sphere
 /// (naming both sizes); a container that cannot take every clone (naming
 /// how many fit); packer errors.
-pub(crate) fn place(
+pub fn place(
     clones: &[ToPlace],
     container: &Container,
     preset: Preset,
     seed: u64,
-) -> anyhow::Result<Vec<Isometry3<f64>>> {
+) -> Result<Vec<Isometry3<f64>>> {
     if clones.is_empty() {
-        bail!("no clone to place");
+        return Err(Error::Scene("no clone to place".to_owned()));
     }
     let sizes: Vec<f64> = clones.iter().map(|c| 2.0 * c.bounding_radius).collect();
     let (lo, hi) = sizes
@@ -87,9 +76,9 @@ pub(crate) fn place(
         .fold((f64::INFINITY, 0.0_f64), |(a, b), d| (a.min(*d), b.max(*d)));
     let room = container.inscribed_diameter();
     if hi > room {
-        bail!(
+        return Err(Error::Scene(format!(
             "`container` is too small for the largest clone: its bounding sphere has diameter {hi:.4}, the container takes at most {room:.4}"
-        );
+        )));
     }
     let params = match preset {
         Preset::Default => Pack3Params::default(),
@@ -97,11 +86,10 @@ pub(crate) fn place(
     };
     let packing = packer_spheres::pack3d_sizes(container, &sizes, lo, hi, &params)?;
     if packing.spheres.len() < clones.len() {
-        return Err(ContainerFull {
+        return Err(Error::ContainerFull {
             clones: clones.len(),
             placed: packing.spheres.len(),
-        }
-        .into());
+        });
     }
     // The packer may place sizes out of order (its look-ahead window):
     // match every placed sphere to an unused clone of the same size.
@@ -117,7 +105,9 @@ pub(crate) fn place(
             .take_while(|&j| sorted[j] <= d * (1.0 + 1e-12))
             .find(|&j| !used[j]);
         let Some(j) = pick else {
-            bail!("placement: a packed sphere of diameter {d} matches no clone (a packer bug)");
+            return Err(Error::Scene(format!(
+                "placement: a packed sphere of diameter {d} matches no clone (a packer bug)"
+            )));
         };
         used[j] = true;
         centres[order[j]] = Some(s.center);
@@ -127,7 +117,10 @@ pub(crate) fn place(
         .zip(centres)
         .map(|(c, p)| {
             let Some(p) = p else {
-                bail!("placement: clone {} was not placed (a packer bug)", c.index);
+                return Err(Error::Scene(format!(
+                    "placement: clone {} was not placed (a packer bug)",
+                    c.index
+                )));
             };
             Ok(Isometry3::from_parts(
                 Translation3::from(p.coords),
@@ -138,19 +131,19 @@ pub(crate) fn place(
 }
 
 /// A grain packing of the clones.
-pub(crate) struct GrainPlacement {
+pub struct GrainPlacement {
     /// The container (sized by `AutoCylinder`).
-    pub(crate) container: Container,
+    pub container: Container,
     /// Pose of every clone, in input order.
-    pub(crate) poses: Vec<Isometry3<f64>>,
+    pub poses: Vec<Isometry3<f64>>,
     /// Packings tried (`AutoCylinder` lowers the fraction per try).
-    pub(crate) tries: usize,
+    pub tries: usize,
     /// The packer's counters.
-    pub(crate) stats: GrainPackStats,
+    pub stats: GrainPackStats,
 }
 
 /// Solid fraction of an `AutoCylinder` is lowered by this factor per try.
-const FRACTION_STEP: f64 = 0.95;
+pub const FRACTION_STEP: f64 = 0.95;
 /// Packings an `AutoCylinder` tries.
 const FRACTION_TRIES: usize = 6;
 
@@ -174,21 +167,22 @@ fn grain_params(preset: Preset, seed: u64) -> GrainPackParams {
 /// `AutoCylinder` (`auto = Some((solid_fraction, lower_if_needed))`), in a
 /// triaxial cylinder sized for that fraction of grain volume; with
 /// `lower_if_needed` the fraction is lowered by 5 % per try while the packer
-/// cannot separate the grains (a warning on standard error names both).
+/// cannot separate the grains ([`GrainPlacement::tries`] > 1 then: the caller
+/// reports the requested and the reached fraction loudly).
 ///
 /// # Errors
 /// No grain; a container smaller than the largest clone's bounding sphere
 /// (naming both sizes); a container the grains cannot be separated in
 /// (naming the count and the fraction); packer errors.
-pub(crate) fn place_grains(
+pub fn place_grains(
     grains: &[StarGrain],
     container: Option<Container>,
     auto: Option<(f64, bool)>,
     preset: Preset,
     seed: u64,
-) -> anyhow::Result<GrainPlacement> {
+) -> Result<GrainPlacement> {
     if grains.is_empty() {
-        bail!("no clone to place");
+        return Err(Error::Scene("no clone to place".to_owned()));
     }
     let params = grain_params(preset, seed);
     let largest = grains.iter().map(|g| 2.0 * g.r_max()).fold(0.0, f64::max);
@@ -204,9 +198,9 @@ pub(crate) fn place_grains(
     if let Some(c) = container {
         let room = c.inscribed_diameter();
         if largest > room {
-            bail!(
+            return Err(Error::Scene(format!(
                 "`container` is too small for the largest clone: its bounding sphere has diameter {largest:.4}, the container takes at most {room:.4}"
-            );
+            )));
         }
         return match pack_grains(grains, &c, &params) {
             Ok(p) => Ok(GrainPlacement {
@@ -215,11 +209,13 @@ pub(crate) fn place_grains(
                 tries: 1,
                 stats: p.stats,
             }),
-            Err(e) if too_dense(&e) => bail!(
-                "`container` cannot take all {} clones: they fill {:.3} of it and the grain packer cannot separate them ({e}); use a larger container or AutoCylinder",
-                grains.len(),
-                total / c.volume()
-            ),
+            Err(e) if too_dense(&e) => {
+                return Err(Error::Scene(format!(
+                    "`container` cannot take all {} clones: they fill {:.3} of it and the grain packer cannot separate them ({e}); use a larger container or AutoCylinder",
+                    grains.len(),
+                    total / c.volume()
+                )));
+            }
             Err(e) => Err(e.into()),
         };
     }
@@ -233,11 +229,6 @@ pub(crate) fn place_grains(
         if largest <= room {
             match pack_grains(grains, &c, &params) {
                 Ok(p) => {
-                    if tries > 1 {
-                        eprintln!(
-                            "specimen: WARNING: AutoCylinder could not separate the clones at the requested solid fraction {requested:.4}; lowered to {fraction:.4} in {tries} tries (lower_if_needed)"
-                        );
-                    }
                     return Ok(GrainPlacement {
                         container: c,
                         poses: p.poses,
@@ -273,29 +264,29 @@ pub(crate) fn place_grains(
         fraction *= FRACTION_STEP;
     }
     if !lower {
-        bail!(
+        return Err(Error::Scene(format!(
             "`container`: AutoCylinder cannot reach the requested solid fraction {requested:.4} with these {} clones: {last}; lower `solid_fraction`, or set `lower_if_needed: true` to accept a lower one",
             grains.len()
-        );
+        )));
     }
-    bail!(
+    Err(Error::Scene(format!(
         "`container`: AutoCylinder could not separate the {} clones in {FRACTION_TRIES} tries down to solid fraction {:.4} (last {last}); lower `solid_fraction`",
         grains.len(),
         fraction / FRACTION_STEP
-    )
+    )))
 }
 
 /// How much of a specimen the walls hold.
-pub(crate) struct WallShare {
+pub struct WallShare {
     /// Horizontal width of the container (cylinder diameter, smaller box side).
-    pub(crate) width: f64,
+    pub width: f64,
     /// Share of the grains whose centre lies within `d_max` of a wall.
-    pub(crate) near_fraction: f64,
+    pub near_fraction: f64,
 }
 
 /// The container's width and the share of grain centres within `d_max` of
 /// any wall (floor and lid included).
-pub(crate) fn wall_share(c: &Container, poses: &[Isometry3<f64>], d_max: f64) -> WallShare {
+pub fn wall_share(c: &Container, poses: &[Isometry3<f64>], d_max: f64) -> WallShare {
     let width = match c {
         Container::Cylinder { radius, .. } => 2.0 * radius,
         Container::Box { min, max, periodic } => {
@@ -322,7 +313,7 @@ pub(crate) fn wall_share(c: &Container, poses: &[Isometry3<f64>], d_max: f64) ->
 
 /// An isotropic (Haar-uniform) rotation from the `(seed, index)` stream
 /// (Shoemake's three uniforms).
-pub(crate) fn random_rotation(seed: u64, index: u64) -> UnitQuaternion<f64> {
+pub fn random_rotation(seed: u64, index: u64) -> UnitQuaternion<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ ROTATION_STREAM);
     rng.set_stream(index);
     packer_grains::random_rotation(&mut rng)

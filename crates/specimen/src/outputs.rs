@@ -1,142 +1,36 @@
-//! The files of a specimen: a staging folder that makes the whole output
-//! atomic, and the writers of every format (LS-DEM poses, clump files for
-//! LAMMPS, LIGGGHTS and Yade, the VTU of the whole specimen).
-//!
-//! Every file is written into a hidden staging folder beside `out_dir`;
-//! only when every stage has succeeded are the files renamed into
-//! `out_dir`. On an error the staging folder is removed and `out_dir` is
-//! left as it was (not even created).
+//! The writers of a specimen's files that are not DEM decks: the LS-DEM
+//! layout beside the morph files ([`lsdem_files`]), the streaming VTU of the
+//! grains' surfaces ([`VtuWriter`]) and the poses
+//! table ([`poses_csv`]). Pure: bytes or `impl Write`, no paths.
 
 use std::fmt::Write as _;
 use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicU64, Ordering};
 
-use anyhow::Context;
 use nalgebra::{Isometry3, Point3};
 
-/// A hidden folder beside `out_dir` collecting the run's files.
-pub(crate) struct Staging {
-    dir: PathBuf,
-    files: Mutex<Vec<PathBuf>>,
-    committed: bool,
-}
-
-static STAGING_COUNTER: AtomicU64 = AtomicU64::new(0);
-
-impl Staging {
-    /// A fresh staging folder for `out_dir`.
-    pub(crate) fn new(out_dir: &Path) -> anyhow::Result<Self> {
-        let name = out_dir
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "specimen".into());
-        let parent = out_dir
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        let dir = parent.join(format!(
-            ".{name}.staging-{}-{}",
-            std::process::id(),
-            STAGING_COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
-        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-        Ok(Self {
-            dir,
-            files: Mutex::new(Vec::new()),
-            committed: false,
-        })
-    }
-
-    /// The staged path of `rel` (its folder created).
-    pub(crate) fn path(&self, rel: &str) -> anyhow::Result<PathBuf> {
-        let p = self.dir.join(rel);
-        if let Some(d) = p.parent() {
-            std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
-        }
-        if let Ok(mut f) = self.files.lock() {
-            f.push(PathBuf::from(rel));
-        }
-        Ok(p)
-    }
-
-    /// Stages `bytes` as `rel` (a path relative to `out_dir`).
-    pub(crate) fn write(&self, rel: &str, bytes: &[u8]) -> anyhow::Result<()> {
-        let p = self.path(rel)?;
-        std::fs::write(&p, bytes).with_context(|| format!("writing {}", p.display()))
-    }
-
-    /// Stages a relative symbolic link `rel → target` (`target` relative to `rel`'s folder).
-    pub(crate) fn link(&self, rel: &str, target: &str) -> anyhow::Result<()> {
-        let p = self.path(rel)?;
-        std::os::unix::fs::symlink(target, &p)
-            .with_context(|| format!("linking {} to {target}", p.display()))
-    }
-
-    /// Moves every staged file into `out_dir` (renames within one file
-    /// system; a staged folder such as `lsdem/` replaces the one already
-    /// there) and returns their paths relative to `out_dir`, sorted.
-    pub(crate) fn commit(mut self, out_dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
-        let mut files = self.files.lock().map(|f| f.clone()).unwrap_or_default();
-        files.sort();
-        files.dedup();
-        // an output folder of this run replaces the one of an earlier run
-        // (no stale grain files beside the new ones)
-        let mut folders: Vec<PathBuf> = files
-            .iter()
-            .filter(|f| f.components().count() > 1)
-            .filter_map(|f| f.components().next().map(|c| PathBuf::from(c.as_os_str())))
-            .collect();
-        folders.dedup();
-        for d in folders {
-            let old = out_dir.join(d);
-            if old.is_dir() {
-                std::fs::remove_dir_all(&old)
-                    .with_context(|| format!("replacing {}", old.display()))?;
-            }
-        }
-        for rel in &files {
-            let to = out_dir.join(rel);
-            if let Some(d) = to.parent() {
-                std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
-            }
-            std::fs::rename(self.dir.join(rel), &to)
-                .with_context(|| format!("moving {} into place", to.display()))?;
-        }
-        self.committed = true;
-        let _ = std::fs::remove_dir_all(&self.dir);
-        Ok(files)
-    }
-}
-
-impl Drop for Staging {
-    fn drop(&mut self) {
-        if !self.committed {
-            let _ = std::fs::remove_dir_all(&self.dir);
-        }
-    }
-}
+use crate::error::{Error, Result};
 
 /// Where a distinct shape's principal-frame morph file sits in its clone frame.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct LsdemFrame {
+pub struct LsdemFrame {
     /// Morph frame → clone frame (scene units; translation = centre of mass).
-    pub(crate) frame: Isometry3<f64>,
+    pub frame: Isometry3<f64>,
     /// Scene length of one morph grid unit.
-    pub(crate) spacing: f64,
+    pub spacing: f64,
     /// Largest `|I_ij| / I_max` of the morph file's level set.
-    pub(crate) off_diagonal: f64,
+    pub off_diagonal: f64,
 }
 
 /// The LS-DEM files beside the morph files: text files and links (relative to `lsdem/`).
-pub(crate) struct LsdemFiles {
-    pub(crate) text: Vec<(String, Vec<u8>)>,
+pub struct LsdemFiles {
+    /// `(path relative to lsdem/, bytes)` of the text files.
+    pub text: Vec<(String, Vec<u8>)>,
     /// `Morphologies/morph_<k>.dat` → `morph_<t>.dat` for grains that reuse a shape.
-    pub(crate) links: Vec<(String, String)>,
-    pub(crate) worst_off_diagonal: f64,
+    pub links: Vec<(String, String)>,
+    /// Largest `|I_ij| / I_max` over the morph files.
+    pub worst_off_diagonal: f64,
     /// Metres per grid unit.
-    pub(crate) spacing_m: f64,
+    pub spacing_m: f64,
 }
 
 /// The LS-DEM layout (`levelset::io::lsdem`): `InitState/positions_<NAME>.dat` (centres of
@@ -145,14 +39,17 @@ pub(crate) struct LsdemFiles {
 ///
 /// Grain `k` (line `k + 1`) is a copy of shape `template_of(k)`; its morph frame → world
 /// is `poses[k] · frames[t].frame`.
-pub(crate) fn lsdem_files(
+///
+/// # Errors
+/// A shape without its frame; the layout's errors.
+pub fn lsdem_files(
     frames: &[Option<LsdemFrame>],
     poses: &[Isometry3<f64>],
     template_of: &dyn Fn(usize) -> usize,
     metres: f64,
     name: &str,
     provenance: &[String],
-) -> anyhow::Result<LsdemFiles> {
+) -> Result<LsdemFiles> {
     use levelset::io::lsdem;
     let mut grains = Vec::with_capacity(poses.len());
     let mut worst = 0.0f64;
@@ -164,7 +61,10 @@ pub(crate) fn lsdem_files(
             .get(t)
             .copied()
             .flatten()
-            .ok_or_else(|| anyhow::anyhow!("no morph file for shape {t}"))?;
+            .ok_or_else(|| Error::Invalid {
+                what: "LS-DEM frames".into(),
+                message: format!("no morph file for shape {t}"),
+            })?;
         h = f.spacing;
         worst = worst.max(f.off_diagonal);
         let world = pose * f.frame;
@@ -250,7 +150,7 @@ pub(crate) fn lsdem_files(
 /// Float32 (a relative precision of 6·10⁻⁸ is far below a surface cell),
 /// connectivity and offsets Int32 (piece-local), types UInt8, `grain_id`
 /// Int32. ParaView and VTK ≥ 6 read it.
-pub(crate) struct VtuWriter<W: Write> {
+pub struct VtuWriter<W: Write> {
     w: W,
 }
 
@@ -260,21 +160,18 @@ const VTU_BLOCK: usize = 1 << 20;
 
 /// Triangles of several grains in the world frame, with their grain ids.
 #[derive(Default)]
-pub(crate) struct Surfaces {
-    pub(crate) points: Vec<Point3<f64>>,
-    pub(crate) triangles: Vec<[usize; 3]>,
-    pub(crate) grain_ids: Vec<u64>,
+pub struct Surfaces {
+    /// Vertices, world frame, metres.
+    pub points: Vec<Point3<f64>>,
+    /// Triangles (indices into `points`).
+    pub triangles: Vec<[usize; 3]>,
+    /// The grain of each triangle.
+    pub grain_ids: Vec<u64>,
 }
 
 impl Surfaces {
     /// Appends a grain's mesh, moved by `pose` and scaled by `metres` (scene unit → m).
-    pub(crate) fn push(
-        &mut self,
-        id: u64,
-        mesh: &levelset::TriMesh,
-        pose: &Isometry3<f64>,
-        metres: f64,
-    ) {
+    pub fn push(&mut self, id: u64, mesh: &levelset::TriMesh, pose: &Isometry3<f64>, metres: f64) {
         let base = self.points.len();
         self.points
             .extend(mesh.vertices().iter().map(|p| (pose * p) * metres));
@@ -286,7 +183,7 @@ impl Surfaces {
 }
 
 /// Base64 (RFC 4648, with padding) of `bytes`, appended to `out`.
-pub(crate) fn base64_into(bytes: &[u8], out: &mut String) {
+pub fn base64_into(bytes: &[u8], out: &mut String) {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     out.reserve(bytes.len().div_ceil(3) * 4);
     for c in bytes.chunks(3) {
@@ -303,8 +200,7 @@ pub(crate) fn base64_into(bytes: &[u8], out: &mut String) {
 }
 
 /// Decodes base64 (the inverse of [`base64_into`]); `None` on a bad byte.
-#[cfg(test)]
-pub(crate) fn base64_decode(text: &str) -> Option<Vec<u8>> {
+pub fn base64_decode(text: &str) -> Option<Vec<u8>> {
     let val = |c: u8| -> Option<u32> {
         Some(match c {
             b'A'..=b'Z' => c - b'A',
@@ -330,7 +226,11 @@ pub(crate) fn base64_decode(text: &str) -> Option<Vec<u8>> {
 }
 
 impl<W: Write> VtuWriter<W> {
-    pub(crate) fn new(mut w: W) -> std::io::Result<Self> {
+    /// Starts the file (header of the unstructured grid).
+    ///
+    /// # Errors
+    /// The writer's I/O error.
+    pub fn new(mut w: W) -> std::io::Result<Self> {
         writeln!(w, r#"<?xml version="1.0"?>"#)?;
         writeln!(
             w,
@@ -383,7 +283,11 @@ impl<W: Write> VtuWriter<W> {
         writeln!(self.w, "\n</DataArray>")
     }
 
-    pub(crate) fn piece(&mut self, s: &Surfaces) -> std::io::Result<()> {
+    /// Writes one `<Piece>` of surfaces.
+    ///
+    /// # Errors
+    /// The writer's I/O error.
+    pub fn piece(&mut self, s: &Surfaces) -> std::io::Result<()> {
         let too_big = |what: &str| {
             std::io::Error::new(
                 std::io::ErrorKind::InvalidData,
@@ -435,136 +339,32 @@ impl<W: Write> VtuWriter<W> {
         Ok(())
     }
 
-    pub(crate) fn finish(mut self) -> std::io::Result<W> {
+    /// Closes the file and returns the writer.
+    ///
+    /// # Errors
+    /// The writer's I/O error.
+    pub fn finish(mut self) -> std::io::Result<W> {
         writeln!(self.w, "</UnstructuredGrid>\n</VTKFile>")?;
         Ok(self.w)
     }
 }
 
-/// A VTU of [`VtuWriter`] read back: per piece, the point, triangle and
-/// grain-id arrays (tests only).
-#[cfg(test)]
-pub(crate) struct VtuPiece {
-    pub(crate) points: Vec<[f32; 3]>,
-    pub(crate) connectivity: Vec<i32>,
-    pub(crate) offsets: Vec<i32>,
-    pub(crate) types: Vec<u8>,
-    pub(crate) grain_ids: Vec<i32>,
-}
-
-/// Reads back a VTU written by [`VtuWriter`] (tests only): checks the
-/// header counts of every array and the piece's declared sizes.
-#[cfg(test)]
-pub(crate) fn read_vtu(text: &str) -> anyhow::Result<Vec<VtuPiece>> {
-    use anyhow::{bail, ensure};
-    // the header (its own base64 stream: 3 + blocks UInt64), then the blocks
-    let decode = |body: &str| -> anyhow::Result<Vec<u8>> {
-        use std::io::Read as _;
-        let body = body.trim();
-        let first = base64_decode(body.get(..16).unwrap_or(""))
-            .ok_or_else(|| anyhow::anyhow!("bad base64"))?;
-        ensure!(first.len() >= 8, "no header");
-        let blocks = u64::from_le_bytes(first[..8].try_into()?) as usize;
-        let header_chars = (8 * (3 + blocks)).div_ceil(3) * 4;
-        ensure!(body.len() >= header_chars, "truncated header");
-        let header = base64_decode(&body[..header_chars])
-            .ok_or_else(|| anyhow::anyhow!("bad base64 header"))?;
-        let h: Vec<usize> = header
-            .chunks_exact(8)
-            .map(|x| u64::from_le_bytes(x.try_into().unwrap_or([0; 8])) as usize)
-            .collect();
-        ensure!(h.len() == 3 + blocks, "header of {} values", h.len());
-        let z = base64_decode(&body[header_chars..])
-            .ok_or_else(|| anyhow::anyhow!("bad base64 data"))?;
-        ensure!(
-            z.len() == h[3..].iter().sum::<usize>(),
-            "compressed sizes disagree"
-        );
-        let mut out = Vec::new();
-        let mut at = 0;
-        for (k, c) in h[3..].iter().enumerate() {
-            let mut block = Vec::new();
-            flate2::read::ZlibDecoder::new(&z[at..at + c]).read_to_end(&mut block)?;
-            let want = if k + 1 == blocks && h[2] > 0 {
-                h[2]
-            } else {
-                h[1]
-            };
-            ensure!(
-                block.len() == want,
-                "block {k}: {} bytes, not {want}",
-                block.len()
-            );
-            out.extend_from_slice(&block);
-            at += c;
-        }
-        Ok(out)
-    };
-    let attr = |tag: &str, key: &str| -> anyhow::Result<usize> {
-        let k = format!("{key}=\"");
-        let at = tag.find(&k).ok_or_else(|| anyhow::anyhow!("no {key}"))? + k.len();
-        let end = tag[at..]
-            .find('"')
-            .ok_or_else(|| anyhow::anyhow!("bad {key}"))?;
-        Ok(tag[at..at + end].parse()?)
-    };
-    let mut pieces = Vec::new();
-    for chunk in text.split("<Piece ").skip(1) {
-        let head = &chunk[..chunk.find('>').unwrap_or(0)];
-        let (np, nc) = (attr(head, "NumberOfPoints")?, attr(head, "NumberOfCells")?);
-        let mut arrays = Vec::new();
-        for a in chunk.split("<DataArray ").skip(1) {
-            let open = a
-                .find('>')
-                .ok_or_else(|| anyhow::anyhow!("bad DataArray"))?;
-            let close = a
-                .find("</DataArray>")
-                .ok_or_else(|| anyhow::anyhow!("unclosed"))?;
-            ensure!(a[..open].contains(r#"format="binary""#), "not binary");
-            arrays.push(decode(&a[open + 1..close])?);
-        }
-        let [p, c, o, t, g] = <[Vec<u8>; 5]>::try_from(arrays)
-            .map_err(|a| anyhow::anyhow!("{} arrays in a piece, not 5", a.len()))?;
-        let i32s = |b: &[u8]| -> Vec<i32> {
-            b.chunks_exact(4)
-                .map(|x| i32::from_le_bytes([x[0], x[1], x[2], x[3]]))
-                .collect()
-        };
-        let f: Vec<f32> = p
-            .chunks_exact(4)
-            .map(|x| f32::from_le_bytes([x[0], x[1], x[2], x[3]]))
-            .collect();
-        let piece = VtuPiece {
-            points: f.chunks_exact(3).map(|v| [v[0], v[1], v[2]]).collect(),
-            connectivity: i32s(&c),
-            offsets: i32s(&o),
-            types: t,
-            grain_ids: i32s(&g),
-        };
-        if piece.points.len() != np
-            || piece.offsets.len() != nc
-            || piece.types.len() != nc
-            || piece.grain_ids.len() != nc
-            || piece.connectivity.len() != 3 * nc
-        {
-            bail!("a piece's arrays disagree with NumberOfPoints={np} NumberOfCells={nc}");
-        }
-        pieces.push(piece);
-    }
-    Ok(pieces)
-}
-
 /// One line of `poses.csv` (metres).
-pub(crate) struct PoseRow {
-    pub(crate) grain: u64,
-    pub(crate) clone: u64,
-    pub(crate) pose: Isometry3<f64>,
-    pub(crate) bounding_radius: f64,
-    pub(crate) scale: f64,
+pub struct PoseRow {
+    /// Grain number.
+    pub grain: u64,
+    /// The clone whose shape it has.
+    pub clone: u64,
+    /// Clone frame → world, metres.
+    pub pose: Isometry3<f64>,
+    /// Radius about the clone frame's origin that holds the grain, metres.
+    pub bounding_radius: f64,
+    /// Factor applied to the clone's radii.
+    pub scale: f64,
 }
 
 /// `poses.csv`: every placed grain's pose (always written), in metres.
-pub(crate) fn poses_csv(rows: &[PoseRow], provenance: &[String]) -> String {
+pub fn poses_csv(rows: &[PoseRow], provenance: &[String]) -> String {
     let mut s = String::new();
     for l in provenance {
         let _ = writeln!(s, "# {l}");

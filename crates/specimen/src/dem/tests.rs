@@ -48,7 +48,7 @@ fn bodies(templates: usize, n: usize) -> Vec<Body> {
         .collect()
 }
 
-type Writer = fn(&DemSpecimen) -> anyhow::Result<Vec<(String, Vec<u8>)>>;
+type Writer = fn(&DemSpecimen) -> crate::Result<Vec<(String, Vec<u8>)>>;
 
 fn files(f: Writer, templates: &[Template], container: &Container) -> Vec<(String, String)> {
     let b = bodies(templates.len(), 4);
@@ -236,6 +236,51 @@ fn lammps_files_parse() {
     }
     // braces of the Rust format are all substituted
     assert!(!deck.contains("{{") && !deck.contains("}}"));
+}
+
+/// `write_lammps_clump_data` writes the very bytes of `lammps/clumps.data` (box and cylinder,
+/// one-sphere and multisphere bodies), to a `Vec<u8>` or through a `&mut` writer.
+#[test]
+fn clump_data_writer_matches_lammps_files() {
+    let bx = Container::Box {
+        min: Point3::new(-1e-3, -1e-3, 0.0),
+        max: Point3::new(1e-3, 1e-3, 2e-3),
+        periodic: [false, false],
+    };
+    for container in [cylinder(), bx] {
+        let t = [pair(), one()];
+        let b = bodies(t.len(), 5);
+        let material = Material::default();
+        let prov = vec!["grainforge test".to_owned()];
+        let s = DemSpecimen {
+            templates: &t,
+            bodies: &b,
+            container: &container,
+            material: &material,
+            provenance: &prov,
+        };
+        let files = lammps_files(&s).expect("files");
+        let expected = &files
+            .iter()
+            .find(|f| f.0 == "lammps/clumps.data")
+            .expect("clumps.data")
+            .1;
+        let mut data = Vec::new();
+        write_lammps_clump_data(&s, &mut data).expect("write");
+        assert_eq!(&data, expected);
+        let mut cursor = std::io::Cursor::new(Vec::new());
+        write_lammps_clump_data(&s, &mut cursor).expect("write");
+        assert_eq!(&cursor.into_inner(), expected);
+    }
+    // refused like lammps_files
+    let s = DemSpecimen {
+        templates: &[pair()],
+        bodies: &[],
+        container: &cylinder(),
+        material: &Material::default(),
+        provenance: &[],
+    };
+    assert!(write_lammps_clump_data(&s, Vec::new()).is_err());
 }
 
 #[test]
