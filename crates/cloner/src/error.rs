@@ -79,7 +79,7 @@ pub enum Error {
         /// Attempts made.
         attempts: usize,
         /// Why they were rejected.
-        rejections: crate::pipeline::Rejections,
+        rejections: crate::rejections::Rejections,
     },
     /// An empty or reversed index range, or a shard that does not exist.
     #[error("invalid clone range {start}..{end}")]

@@ -109,6 +109,7 @@ pub mod model;
 pub mod output;
 pub mod params;
 pub mod pipeline;
+mod rejections;
 pub mod surface;
 
 pub use calibration::{Calibrated, Scores, score};

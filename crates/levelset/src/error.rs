@@ -251,7 +251,7 @@ pub enum Error {
         /// Linear voxel index (x fastest).
         index: usize,
         /// The requested data type.
-        dtype: crate::io::Dtype,
+        dtype: crate::io::dtype::Dtype,
     },
     /// A data type name or NumPy `descr` that is not supported.
     #[error(

@@ -1,6 +1,6 @@
 //! The crate's error type: one structured variant per kind of bad input.
 
-use crate::table::Descriptor;
+use crate::descriptor::Descriptor;
 
 /// Which moment a [`Error::ZeroReference`] refers to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -88,6 +88,7 @@ pub mod compare;
 pub mod copula;
 pub mod correlation;
 pub mod csv;
+mod descriptor;
 pub mod error;
 pub mod grading;
 pub mod histogram;

@@ -345,7 +345,6 @@ impl System<'_> {
         self.place();
         let n = self.c.len();
         let (proxy, x, c, skin) = (self.proxy, &self.x, &self.c, self.skin);
-        let (rot, eps, lam) = (&self.rot, &self.eps, self.lam);
         // bounding radius of each grain's spheres
         let bound: Vec<f64> = (0..n)
             .map(|b| {
@@ -360,131 +359,20 @@ impl System<'_> {
         let reach = 2.0 * bound.iter().copied().fold(0.0, f64::max) + skin;
         // the centres and their periodic images within reach of a face
         let (ext, real, code) = region.extended(c, reach);
-        let (mut lo, mut hi) = region.bbox();
-        for p in &ext {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        let mut dims = [1usize; 3];
-        let mut side = [0.0; 3];
-        for k in 0..3 {
-            let l = hi[k] - lo[k];
-            dims[k] = ((l / reach).floor() as usize).clamp(1, 1 << 10);
-            side[k] = l / dims[k] as f64;
-        }
-        let cell_of = |p: &Vector3<f64>| -> [usize; 3] {
-            let mut q = [0usize; 3];
-            for k in 0..3 {
-                let i = ((p[k] - lo[k]) / side[k]).floor();
-                q[k] = if i.is_nan() || i < 0.0 {
-                    0
-                } else {
-                    (i as usize).min(dims[k] - 1)
-                };
-            }
-            q
+        let grid = CentreGrid::new(region, &ext, reach);
+        let ctx = ListBuild {
+            sys: self,
+            bound: &bound,
+            ext: &ext,
+            real: &real,
+            code: &code,
+            grid: &grid,
         };
-        let ncell = dims[0] * dims[1] * dims[2];
-        let mut head = vec![0u32; ncell + 1];
-        let cells: Vec<usize> = ext
-            .iter()
-            .map(|p| {
-                let q = cell_of(p);
-                (q[2] * dims[1] + q[1]) * dims[0] + q[0]
-            })
-            .collect();
-        for &q in &cells {
-            head[q + 1] += 1;
-        }
-        for i in 0..ncell {
-            head[i + 1] += head[i];
-        }
-        let mut fill = head.clone();
-        let mut order = vec![0u32; ext.len()];
-        for (i, &q) in cells.iter().enumerate() {
-            order[fill[q] as usize] = i as u32;
-            fill[q] += 1;
-        }
         // per grain: its spheres' lists (flat) and their lengths
         let lists: Vec<(Vec<u32>, Vec<u32>)> = (0..n)
             .into_par_iter()
             .with_min_len(16)
-            .map(|i| {
-                let mine = proxy.start[i]..proxy.start[i + 1];
-                let q = cell_of(&c[i]);
-                let mut others: Vec<usize> = Vec::with_capacity(32);
-                for cz in q[2].saturating_sub(1)..=(q[2] + 1).min(dims[2] - 1) {
-                    for cy in q[1].saturating_sub(1)..=(q[1] + 1).min(dims[1] - 1) {
-                        for cx in q[0].saturating_sub(1)..=(q[0] + 1).min(dims[0] - 1) {
-                            let cell = (cz * dims[1] + cy) * dims[0] + cx;
-                            for &e in &order[head[cell] as usize..head[cell + 1] as usize] {
-                                let j = real[e as usize] as usize;
-                                let cut = bound[i] + bound[j] + skin;
-                                if j != i && (c[i] - ext[e as usize]).norm_squared() < cut * cut {
-                                    others.push(e as usize);
-                                }
-                            }
-                        }
-                    }
-                }
-                others.sort_unstable();
-                // world bounds of the clusters of grain b (empty ones: radius < 0)
-                let clusters = |b: usize, at: &Vector3<f64>| -> [(Vector3<f64>, f64); CLUSTERS] {
-                    let mut out = [(Vector3::zeros(), -1.0); CLUSTERS];
-                    for (k, o) in out.iter_mut().enumerate() {
-                        let (cc, rr) = proxy.bounds[b * CLUSTERS + k];
-                        if rr >= 0.0 {
-                            *o = (at + rot[b] * (lam * cc), lam * rr + eps[b]);
-                        }
-                    }
-                    out
-                };
-                let ci = clusters(i, &c[i]);
-                let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(mine.len() * 8);
-                for &e in &others {
-                    let j = real[e] as usize;
-                    let sh = ext[e] - c[j];
-                    let tag = if code[e] == NO_SHIFT {
-                        0
-                    } else {
-                        (u32::from(code[e]) + 1) << INDEX_BITS
-                    };
-                    let cj = clusters(j, &ext[e]);
-                    for (a, (pa, ra)) in ci.iter().enumerate() {
-                        if *ra < 0.0 {
-                            continue;
-                        }
-                        for (b, (pb, rb)) in cj.iter().enumerate() {
-                            let cut = ra + rb + skin;
-                            if *rb < 0.0 || (pa - pb).norm_squared() >= cut * cut {
-                                continue;
-                            }
-                            let ga =
-                                proxy.groups[i * CLUSTERS + a]..proxy.groups[i * CLUSTERS + a + 1];
-                            let gb =
-                                proxy.groups[j * CLUSTERS + b]..proxy.groups[j * CLUSTERS + b + 1];
-                            for s in ga {
-                                // sphere s moved by the image's inverse shift
-                                let p = [x[s][0] - sh.x, x[s][1] - sh.y, x[s][2] - sh.z];
-                                for t in gb.clone() {
-                                    let d = [p[0] - x[t][0], p[1] - x[t][1], p[2] - x[t][2]];
-                                    let cut = x[s][3] + x[t][3] + skin;
-                                    if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut {
-                                        pairs.push((s as u32, t as u32 | tag));
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-                pairs.sort_unstable();
-                let mut lens = vec![0u32; mine.len()];
-                for &(s, _) in &pairs {
-                    lens[s as usize - mine.start] += 1;
-                }
-                let flat: Vec<u32> = pairs.into_iter().map(|(_, t)| t).collect();
-                (flat, lens)
-            })
+            .map(|i| ctx.grain_lists(i))
             .collect();
         self.start.clear();
         self.list.clear();
@@ -856,6 +744,185 @@ fn not_converged(sys: &mut System<'_>, stats: &CompactStats, lam: f64) -> Error 
         sweeps: stats.iterations,
         overlapping_pairs: pairs.len(),
         scale: lam,
+    }
+}
+
+/// A cell grid (cells of side ≥ the reach) of the grain centres and their
+/// periodic images, in counting-sort order.
+struct CentreGrid {
+    lo: Vector3<f64>,
+    dims: [usize; 3],
+    side: [f64; 3],
+    /// `head[q]..head[q + 1]`: the entries of cell `q` in `order`.
+    head: Vec<u32>,
+    order: Vec<u32>,
+}
+
+impl CentreGrid {
+    /// The grid of `ext` over the region's box grown to hold every entry.
+    fn new(region: &Region<'_>, ext: &[Vector3<f64>], reach: f64) -> Self {
+        let (mut lo, mut hi) = region.bbox();
+        for p in ext {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let mut dims = [1usize; 3];
+        let mut side = [0.0; 3];
+        for k in 0..3 {
+            let l = hi[k] - lo[k];
+            dims[k] = ((l / reach).floor() as usize).clamp(1, 1 << 10);
+            side[k] = l / dims[k] as f64;
+        }
+        let mut grid = Self {
+            lo,
+            dims,
+            side,
+            head: Vec::new(),
+            order: Vec::new(),
+        };
+        let ncell = dims[0] * dims[1] * dims[2];
+        let mut head = vec![0u32; ncell + 1];
+        let cells: Vec<usize> = ext
+            .iter()
+            .map(|p| {
+                let q = grid.cell_of(p);
+                (q[2] * dims[1] + q[1]) * dims[0] + q[0]
+            })
+            .collect();
+        for &q in &cells {
+            head[q + 1] += 1;
+        }
+        for i in 0..ncell {
+            head[i + 1] += head[i];
+        }
+        let mut fill = head.clone();
+        let mut order = vec![0u32; ext.len()];
+        for (i, &q) in cells.iter().enumerate() {
+            order[fill[q] as usize] = i as u32;
+            fill[q] += 1;
+        }
+        grid.head = head;
+        grid.order = order;
+        grid
+    }
+
+    /// The cell of a point (clamped into the grid).
+    #[inline]
+    fn cell_of(&self, p: &Vector3<f64>) -> [usize; 3] {
+        let mut q = [0usize; 3];
+        for k in 0..3 {
+            let i = ((p[k] - self.lo[k]) / self.side[k]).floor();
+            q[k] = if i.is_nan() || i < 0.0 {
+                0
+            } else {
+                (i as usize).min(self.dims[k] - 1)
+            };
+        }
+        q
+    }
+}
+
+/// What the neighbour-list build of one grain reads: the system, the
+/// grains' bounding radii and the centres with their images on a grid.
+struct ListBuild<'s, 'a> {
+    sys: &'s System<'a>,
+    bound: &'s [f64],
+    ext: &'s [Vector3<f64>],
+    real: &'s [u32],
+    code: &'s [u8],
+    grid: &'s CentreGrid,
+}
+
+impl ListBuild<'_, '_> {
+    /// Entries of `ext` (other grains or images) whose bounding spheres
+    /// come within the skin of grain `i`'s, sorted.
+    fn others(&self, i: usize) -> Vec<usize> {
+        let (c, grid, skin) = (&self.sys.c, self.grid, self.sys.skin);
+        let dims = grid.dims;
+        let q = grid.cell_of(&c[i]);
+        let mut others: Vec<usize> = Vec::with_capacity(32);
+        for cz in q[2].saturating_sub(1)..=(q[2] + 1).min(dims[2] - 1) {
+            for cy in q[1].saturating_sub(1)..=(q[1] + 1).min(dims[1] - 1) {
+                for cx in q[0].saturating_sub(1)..=(q[0] + 1).min(dims[0] - 1) {
+                    let cell = (cz * dims[1] + cy) * dims[0] + cx;
+                    for &e in &grid.order[grid.head[cell] as usize..grid.head[cell + 1] as usize] {
+                        let j = self.real[e as usize] as usize;
+                        let cut = self.bound[i] + self.bound[j] + skin;
+                        if j != i && (c[i] - self.ext[e as usize]).norm_squared() < cut * cut {
+                            others.push(e as usize);
+                        }
+                    }
+                }
+            }
+        }
+        others.sort_unstable();
+        others
+    }
+
+    /// World bounds of the clusters of grain `b` at `at` (empty ones:
+    /// radius < 0).
+    #[inline]
+    fn clusters(&self, b: usize, at: &Vector3<f64>) -> [(Vector3<f64>, f64); CLUSTERS] {
+        let (proxy, rot, eps, lam) = (self.sys.proxy, &self.sys.rot, &self.sys.eps, self.sys.lam);
+        let mut out = [(Vector3::zeros(), -1.0); CLUSTERS];
+        for (k, o) in out.iter_mut().enumerate() {
+            let (cc, rr) = proxy.bounds[b * CLUSTERS + k];
+            if rr >= 0.0 {
+                *o = (at + rot[b] * (lam * cc), lam * rr + eps[b]);
+            }
+        }
+        out
+    }
+
+    /// The sphere lists of grain `i`: its spheres' partners (flat, with
+    /// the image tag) and the list length of each of its spheres.
+    fn grain_lists(&self, i: usize) -> (Vec<u32>, Vec<u32>) {
+        let (proxy, x, c, skin) = (self.sys.proxy, &self.sys.x, &self.sys.c, self.sys.skin);
+        let mine = proxy.start[i]..proxy.start[i + 1];
+        let others = self.others(i);
+        let ci = self.clusters(i, &c[i]);
+        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(mine.len() * 8);
+        for &e in &others {
+            let j = self.real[e] as usize;
+            let sh = self.ext[e] - c[j];
+            let tag = if self.code[e] == NO_SHIFT {
+                0
+            } else {
+                (u32::from(self.code[e]) + 1) << INDEX_BITS
+            };
+            let cj = self.clusters(j, &self.ext[e]);
+            for (a, (pa, ra)) in ci.iter().enumerate() {
+                if *ra < 0.0 {
+                    continue;
+                }
+                for (b, (pb, rb)) in cj.iter().enumerate() {
+                    let cut = ra + rb + skin;
+                    if *rb < 0.0 || (pa - pb).norm_squared() >= cut * cut {
+                        continue;
+                    }
+                    let ga = proxy.groups[i * CLUSTERS + a]..proxy.groups[i * CLUSTERS + a + 1];
+                    let gb = proxy.groups[j * CLUSTERS + b]..proxy.groups[j * CLUSTERS + b + 1];
+                    for s in ga {
+                        // sphere s moved by the image's inverse shift
+                        let p = [x[s][0] - sh.x, x[s][1] - sh.y, x[s][2] - sh.z];
+                        for t in gb.clone() {
+                            let d = [p[0] - x[t][0], p[1] - x[t][1], p[2] - x[t][2]];
+                            let cut = x[s][3] + x[t][3] + skin;
+                            if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut {
+                                pairs.push((s as u32, t as u32 | tag));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        pairs.sort_unstable();
+        let mut lens = vec![0u32; mine.len()];
+        for &(s, _) in &pairs {
+            lens[s as usize - mine.start] += 1;
+        }
+        let flat: Vec<u32> = pairs.into_iter().map(|(_, t)| t).collect();
+        (flat, lens)
     }
 }
 

@@ -670,70 +670,14 @@ fn relax_at(
         let frame: &Frame = frame_mut;
         let near = Near::new(frame, region, centres);
         if *sweeps >= max_sweeps {
-            let c: &[Vector3<f64>] = centres;
-            let left: usize = (0..n)
-                .into_par_iter()
-                .map(|i| {
-                    let mut cnt = 0;
-                    frame.for_pairs(&near, i, |j, cj| {
-                        if frame.pair(shapes, i, j, &c[i], cj, lam).depth > 0.0 {
-                            cnt += 1;
-                        }
-                    });
-                    cnt
-                })
-                .sum();
             return Err(Error::NotConverged {
                 sweeps: *sweeps,
-                overlapping_pairs: left,
+                overlapping_pairs: overlapping_pairs(frame, shapes, &near, centres, lam),
                 scale: lam,
             });
         }
         *sweeps += 1;
-        let c: &[Vector3<f64>] = centres;
-        let mv: &[bool] = moved;
-        // Only pairs with a moved grain: each is tested from its moved
-        // grain (the lower one when both moved).
-        let active: Vec<usize> = (0..n).filter(|&i| mv[i]).collect();
-        let found: Vec<(usize, Vec<Push>, u64)> = active
-            .par_iter()
-            .with_min_len(16)
-            .map(|&i| {
-                let mut out = Vec::new();
-                let mut tests = 0;
-                frame.for_neighbours(&near, i, |j, cj| {
-                    if mv[j] && j < i {
-                        return;
-                    }
-                    tests += 1;
-                    let acc = frame.pair(shapes, i, j, &c[i], cj, lam);
-                    if acc.depth > 0.0 {
-                        let mut dir = acc.dir;
-                        if dir.norm().partial_cmp(&(1e-12 * acc.depth))
-                            != Some(std::cmp::Ordering::Greater)
-                        {
-                            dir = c[i] - cj;
-                        }
-                        let len = dir.norm();
-                        let dir = if len > 0.0 { dir / len } else { Vector3::z() };
-                        let extra = OVERSHOOT * frame.mu[i].max(frame.mu[j]);
-                        let step = 0.5 * (acc.depth + extra);
-                        let x = if acc.weight > 0.0 {
-                            acc.point / acc.weight
-                        } else {
-                            0.5 * (c[i] + cj)
-                        };
-                        out.push(Push {
-                            b: j,
-                            move_a: rigid_move(&(x - c[i]), &dir, step, frame.k2[i]),
-                            move_b: rigid_move(&(x - cj), &(-dir), step, frame.k2[j]),
-                            depth_over_d: acc.depth / frame.d_eq[i].min(frame.d_eq[j]),
-                        });
-                    }
-                });
-                (i, out, tests)
-            })
-            .collect();
+        let found = find_pushes(frame, shapes, &near, centres, moved, lam);
         let mut disp = vec![Vector3::zeros(); n];
         let mut turn = vec![Vector3::zeros(); n];
         let mut count = vec![0u32; n];
@@ -776,34 +720,7 @@ fn relax_at(
         let walls: Vec<Option<Vector3<f64>>> = (0..n)
             .into_par_iter()
             .with_min_len(64)
-            .map(|i| {
-                if region.clearance(&c[i].into()) >= lam * frame.reach[i] {
-                    return None;
-                }
-                let mut p = c[i];
-                let mu = frame.mu[i];
-                let mut changed = false;
-                for _ in 0..6 {
-                    let (cl, x) = shapes.wall(i, &frame.rots[i], &p, lam, region);
-                    if cl >= mu {
-                        break;
-                    }
-                    let h = 1e-4 * frame.d_eq[i];
-                    let mut g = Vector3::zeros();
-                    for a in 0..3 {
-                        let mut e = Vector3::zeros();
-                        e[a] = h;
-                        g[a] = (region.clearance(&(x + e).into())
-                            - region.clearance(&(x - e).into()))
-                            / (2.0 * h);
-                    }
-                    let len = g.norm();
-                    let g = if len > 0.0 { g / len } else { Vector3::z() };
-                    p += (mu - cl + OVERSHOOT * mu) * g;
-                    changed = true;
-                }
-                changed.then_some(p)
-            })
+            .map(|i| wall_projection(frame, shapes, region, i, &c[i], lam))
             .collect();
         let mut any = overlaps > 0;
         for (i, w) in walls.into_iter().enumerate() {
@@ -818,6 +735,128 @@ fn relax_at(
         }
     }
     Ok(false)
+}
+
+/// Pairs still overlapping at scale `lam` (the count of
+/// [`Error::NotConverged`]).
+fn overlapping_pairs(
+    frame: &Frame,
+    shapes: &Shapes<'_>,
+    near: &Near,
+    c: &[Vector3<f64>],
+    lam: f64,
+) -> usize {
+    (0..c.len())
+        .into_par_iter()
+        .map(|i| {
+            let mut cnt = 0;
+            frame.for_pairs(near, i, |j, cj| {
+                if frame.pair(shapes, i, j, &c[i], cj, lam).depth > 0.0 {
+                    cnt += 1;
+                }
+            });
+            cnt
+        })
+        .sum()
+}
+
+/// The pushes of one sweep: for each moved grain `i`, its overlapping
+/// pairs and the pair tests made. Only pairs with a moved grain are
+/// tested, each from its moved grain (the lower one when both moved).
+fn find_pushes(
+    frame: &Frame,
+    shapes: &Shapes<'_>,
+    near: &Near,
+    c: &[Vector3<f64>],
+    mv: &[bool],
+    lam: f64,
+) -> Vec<(usize, Vec<Push>, u64)> {
+    let active: Vec<usize> = (0..c.len()).filter(|&i| mv[i]).collect();
+    active
+        .par_iter()
+        .with_min_len(16)
+        .map(|&i| {
+            let mut out = Vec::new();
+            let mut tests = 0;
+            frame.for_neighbours(near, i, |j, cj| {
+                if mv[j] && j < i {
+                    return;
+                }
+                tests += 1;
+                let acc = frame.pair(shapes, i, j, &c[i], cj, lam);
+                if acc.depth > 0.0 {
+                    out.push(frame.push(&acc, i, j, &c[i], cj));
+                }
+            });
+            (i, out, tests)
+        })
+        .collect()
+}
+
+impl Frame {
+    /// The push of an overlapping pair `(a, b)` at `ca`, `cb` from its node
+    /// test `acc`: both grains apart along the depth-weighted normal by half
+    /// the depth plus the overshoot, at the contact point.
+    #[inline]
+    fn push(&self, acc: &Acc, a: usize, b: usize, ca: &Vector3<f64>, cb: &Vector3<f64>) -> Push {
+        let mut dir = acc.dir;
+        if dir.norm().partial_cmp(&(1e-12 * acc.depth)) != Some(std::cmp::Ordering::Greater) {
+            dir = ca - cb;
+        }
+        let len = dir.norm();
+        let dir = if len > 0.0 { dir / len } else { Vector3::z() };
+        let extra = OVERSHOOT * self.mu[a].max(self.mu[b]);
+        let step = 0.5 * (acc.depth + extra);
+        let x = if acc.weight > 0.0 {
+            acc.point / acc.weight
+        } else {
+            0.5 * (ca + cb)
+        };
+        Push {
+            b,
+            move_a: rigid_move(&(x - ca), &dir, step, self.k2[a]),
+            move_b: rigid_move(&(x - cb), &(-dir), step, self.k2[b]),
+            depth_over_d: acc.depth / self.d_eq[a].min(self.d_eq[b]),
+        }
+    }
+}
+
+/// Grain `i` at `ci` projected back inside the walls until its nodes clear
+/// them by the margin (up to 6 steps along the clearance gradient), or
+/// `None` when it already does.
+fn wall_projection(
+    frame: &Frame,
+    shapes: &Shapes<'_>,
+    region: &Region<'_>,
+    i: usize,
+    ci: &Vector3<f64>,
+    lam: f64,
+) -> Option<Vector3<f64>> {
+    if region.clearance(&(*ci).into()) >= lam * frame.reach[i] {
+        return None;
+    }
+    let mut p = *ci;
+    let mu = frame.mu[i];
+    let mut changed = false;
+    for _ in 0..6 {
+        let (cl, x) = shapes.wall(i, &frame.rots[i], &p, lam, region);
+        if cl >= mu {
+            break;
+        }
+        let h = 1e-4 * frame.d_eq[i];
+        let mut g = Vector3::zeros();
+        for a in 0..3 {
+            let mut e = Vector3::zeros();
+            e[a] = h;
+            g[a] =
+                (region.clearance(&(x + e).into()) - region.clearance(&(x - e).into())) / (2.0 * h);
+        }
+        let len = g.norm();
+        let g = if len > 0.0 { g / len } else { Vector3::z() };
+        p += (mu - cl + OVERSHOOT * mu) * g;
+        changed = true;
+    }
+    changed.then_some(p)
 }
 
 #[cfg(test)]

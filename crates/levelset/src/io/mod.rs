@@ -20,6 +20,7 @@
 //! [`crate::TriMesh::prepare_closed`] next, which repairs or refuses orientation and
 //! names what is wrong with an open or non-manifold mesh; the caller adds the file name.
 
+pub(crate) mod dtype;
 mod lammps;
 pub mod lsdem;
 mod morph;
@@ -30,12 +31,13 @@ mod stl;
 mod tiff_stack;
 mod vtk;
 
+pub use dtype::Dtype;
 pub use lammps::{read_lammps, write_lammps};
 pub use lsdem::{PrincipalMorph, principal_morph};
 pub use morph::{MorphFile, read_morph, write_morph, write_morph_decimals};
 pub use npy::{read_npy, write_npy};
 pub use obj::{read_obj, write_obj};
-pub use raw::{Dtype, RawLayout, read_raw, write_raw};
+pub use raw::{RawLayout, read_raw, write_raw};
 pub use stl::{read_stl, write_stl_ascii, write_stl_binary};
 pub use tiff_stack::{read_tiff, write_tiff};
 pub use vtk::{read_vtk, write_vtk};

@@ -16,7 +16,8 @@
 
 use std::io::{Read, Write};
 
-use super::raw::{Dtype, fill, read_elements, write_elements};
+use super::Dtype;
+use super::raw::{fill, read_elements, write_elements};
 use crate::error::{Error, Result};
 use crate::labels::{LabelImage, check_spacing, checked_len};
 

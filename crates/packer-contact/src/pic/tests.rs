@@ -1,6 +1,11 @@
 //! Golden digests, overlap-free packings of every shape (parry checker), bad input, VTU.
 
+use super::wrap::tangent3;
 use super::*;
+use crate::contact3d::{self, Wrapper3};
+use crate::error::Error;
+use crate::shapes::{Grain, GrainShape};
+use nalgebra::{Point2, Point3, SVector};
 use proptest::prelude::*;
 
 /// FNV-1a over the bits of every centre.
