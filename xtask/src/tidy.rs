@@ -491,3 +491,58 @@ fn lengths_skip_comments_strings_and_tests() {
     let (fns, _) = lengths::measure(&long);
     assert_eq!(fns[0].lines, 202);
 }
+
+/// The source file of module path `segments` under `src` (`a::b` → `src/a/b.rs` or
+/// `src/a/b/mod.rs`), trying the longest prefix that is a module file.
+fn module_file(src: &Path, segments: &[&str]) -> Option<PathBuf> {
+    (1..=segments.len()).rev().find_map(|n| {
+        let rel: PathBuf = segments[..n].iter().collect();
+        [
+            src.join(&rel).with_extension("rs"),
+            src.join(&rel).join("mod.rs"),
+        ]
+        .into_iter()
+        .find(|p| p.exists())
+    })
+}
+
+#[test]
+fn error_types_form_no_module_cycle() {
+    // A library's `error.rs` may name types of other modules (a rejection
+    // count, a dtype), but those modules must not use the error type back:
+    // such a type sits in the wrong file (issue 29).
+    let mut cycles = Vec::new();
+    for name in LIBRARIES {
+        let src = crate_dir(name).join("src");
+        let error = read(&src.join("error.rs"));
+        let code = lengths::blank(&error);
+        for at in code
+            .match_indices("crate::")
+            .map(|(i, _)| i + "crate::".len())
+        {
+            let path: Vec<&str> = code[at..]
+                .split(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+                .next()
+                .unwrap_or("")
+                .split("::")
+                .filter(|s| s.chars().next().is_some_and(char::is_lowercase))
+                .collect();
+            if path.is_empty() || path[0] == "error" {
+                continue;
+            }
+            if let Some(file) = module_file(&src, &path) {
+                let text = lengths::blank(&read(&file));
+                if text.contains("crate::error") || text.contains("crate::{Error") {
+                    cycles.push(format!(
+                        "{name}: error.rs uses {} and {} uses the error type",
+                        path.join("::"),
+                        file.strip_prefix(root()).unwrap_or(&file).display()
+                    ));
+                }
+            }
+        }
+    }
+    cycles.sort();
+    cycles.dedup();
+    assert!(cycles.is_empty(), "{}", cycles.join("\n"));
+}

@@ -596,253 +596,338 @@ pub fn write_vtu3(spheres: &[Sphere], mut w: impl Write) -> Result<()> {
 /// data, a missing or mis-sized points or radius array, a non-finite value
 /// or a non-positive radius; [`Error::Io`] from the reader.
 pub fn read_vtu3(mut r: impl BufRead) -> Result<Vec<Sphere>> {
-    const F: &str = "vtu";
     let mut bytes = Vec::new();
     r.read_to_end(&mut bytes)?;
-    let text = match std::str::from_utf8(&bytes) {
-        Ok(t) => t,
+    let text = vtu_text(&bytes)?;
+    let mut reader = VtuReader {
+        stack: Vec::new(),
+        seen_file: false,
+        npoints: None,
+        array: None,
+        points: None,
+        radii: None,
+        values: Vec::new(),
+        line: 1,
+    };
+    let mut pos = 0;
+    while pos < text.len() {
+        let rest = &text[pos..];
+        pos += if let Some(body) = rest.strip_prefix("<!--") {
+            reader.comment(rest, body)?
+        } else if rest.starts_with('<') {
+            reader.tag(rest)?
+        } else {
+            reader.text(rest)?
+        };
+    }
+    reader.finish(text)
+}
+
+/// Format name of the VTU reader's errors.
+const VTU: &str = "vtu";
+
+/// The input as UTF-8, or the line of the first invalid byte.
+fn vtu_text(bytes: &[u8]) -> Result<&str> {
+    match std::str::from_utf8(bytes) {
+        Ok(t) => Ok(t),
         Err(e) => {
             let line = 1 + bytes[..e.valid_up_to()]
                 .iter()
                 .filter(|&&b| b == b'\n')
                 .count();
-            return Err(parse_error(F, line, "not valid UTF-8"));
+            Err(parse_error(VTU, line, "not valid UTF-8"))
         }
-    };
-    let mut stack: Vec<(&str, usize)> = Vec::new();
-    let mut seen_file = false;
-    let mut npoints: Option<usize> = None;
-    // The DataArray being read: what it is for and the line of its tag.
-    let mut array: Option<(VtuArray, usize)> = None;
-    let mut points: Option<(Vec<(f64, usize)>, usize)> = None;
-    let mut radii: Option<(Vec<(f64, usize)>, usize)> = None;
-    let mut values: Vec<(f64, usize)> = Vec::new();
+    }
+}
 
-    let mut pos = 0;
-    let mut line = 1;
-    while pos < text.len() {
-        let rest = &text[pos..];
-        if let Some(body) = rest.strip_prefix("<!--") {
-            let Some(end) = body.find("-->") else {
-                return Err(parse_error(F, line, "unterminated comment"));
-            };
-            let len = 4 + end + 3;
-            line += count_newlines(&rest[..len]);
-            pos += len;
-            continue;
+/// A `(value, line)` list and the line of its `DataArray` tag.
+type VtuValues = (Vec<(f64, usize)>, usize);
+
+/// The state of [`read_vtu3`]'s pass over the text.
+struct VtuReader<'a> {
+    /// Open elements and the lines of their tags.
+    stack: Vec<(&'a str, usize)>,
+    seen_file: bool,
+    npoints: Option<usize>,
+    /// The DataArray being read: what it is for and the line of its tag.
+    array: Option<(VtuArray, usize)>,
+    points: Option<VtuValues>,
+    radii: Option<VtuValues>,
+    /// Values of the array being read.
+    values: Vec<(f64, usize)>,
+    /// Line at the current position.
+    line: usize,
+}
+
+/// The value of attribute `key`.
+fn vtu_attr<'v>(attrs: &[(&str, &'v str)], key: &str) -> Option<&'v str> {
+    attrs.iter().find(|(k, _)| *k == key).map(|(_, v)| *v)
+}
+
+impl<'a> VtuReader<'a> {
+    /// Skips the comment at the start of `rest` (`body` after its `<!--`);
+    /// returns its length.
+    fn comment(&mut self, rest: &str, body: &str) -> Result<usize> {
+        let Some(end) = body.find("-->") else {
+            return Err(parse_error(VTU, self.line, "unterminated comment"));
+        };
+        let len = 4 + end + 3;
+        self.line += count_newlines(&rest[..len]);
+        Ok(len)
+    }
+
+    /// Reads the tag at the start of `rest` (declarations skipped); returns
+    /// its length.
+    fn tag(&mut self, rest: &'a str) -> Result<usize> {
+        let Some(end) = rest.find('>') else {
+            return Err(parse_error(VTU, self.line, "unterminated tag"));
+        };
+        let tag = &rest[1..end];
+        let tag_line = self.line;
+        self.line += count_newlines(&rest[..=end]);
+        if tag.starts_with('?') {
+            return Ok(end + 1);
         }
-        if rest.starts_with('<') {
-            let Some(end) = rest.find('>') else {
-                return Err(parse_error(F, line, "unterminated tag"));
-            };
-            let tag = &rest[1..end];
-            let tag_line = line;
-            line += count_newlines(&rest[..=end]);
-            pos += end + 1;
-            if tag.starts_with('?') {
-                continue;
+        if let Some(name) = tag.strip_prefix('/') {
+            self.close(name.trim(), tag_line)?;
+        } else {
+            self.open(tag, tag_line)?;
+        }
+        Ok(end + 1)
+    }
+
+    /// A closing tag: it must close the innermost open element; a
+    /// `DataArray` being read is stored.
+    fn close(&mut self, name: &str, tag_line: usize) -> Result<()> {
+        match self.stack.pop() {
+            Some((open, _)) if open == name => {}
+            Some((open, _)) => {
+                return Err(parse_error(
+                    VTU,
+                    tag_line,
+                    format!("`</{name}>` closes `<{open}>`"),
+                ));
             }
-            if let Some(name) = tag.strip_prefix('/') {
-                let name = name.trim();
-                match stack.pop() {
-                    Some((open, _)) if open == name => {}
-                    Some((open, _)) => {
-                        return Err(parse_error(
-                            F,
-                            tag_line,
-                            format!("`</{name}>` closes `<{open}>`"),
-                        ));
-                    }
-                    None => {
-                        return Err(parse_error(
-                            F,
-                            tag_line,
-                            format!("`</{name}>` without an opening tag"),
-                        ));
-                    }
-                }
-                if name == "DataArray"
-                    && let Some((kind, array_line)) = array.take()
-                {
-                    let vals = std::mem::take(&mut values);
-                    match kind {
-                        VtuArray::Points => points = Some((vals, array_line)),
-                        VtuArray::Radius => radii = Some((vals, array_line)),
-                        VtuArray::Skip => {}
-                    }
-                }
-                continue;
+            None => {
+                return Err(parse_error(
+                    VTU,
+                    tag_line,
+                    format!("`</{name}>` without an opening tag"),
+                ));
             }
-            let (tag, self_closing) = match tag.strip_suffix('/') {
-                Some(t) => (t, true),
-                None => (tag, false),
-            };
-            let (name, attrs) = parse_tag(F, tag_line, tag)?;
-            let attr = |key: &str| attrs.iter().find(|(k, _)| *k == key).map(|(_, v)| *v);
-            let parent = stack.last().map(|(p, _)| *p);
-            match (name, parent) {
-                ("VTKFile", None) => {
-                    if seen_file {
-                        return Err(parse_error(F, tag_line, "second VTKFile element"));
-                    }
-                    seen_file = true;
-                    if attr("type") != Some("UnstructuredGrid") {
-                        return Err(parse_error(F, tag_line, "not a VTK UnstructuredGrid file"));
-                    }
-                    if attr("compressor").is_some() {
-                        return Err(parse_error(
-                            F,
-                            tag_line,
-                            "compressed files are not supported",
-                        ));
-                    }
+        }
+        if name == "DataArray"
+            && let Some((kind, array_line)) = self.array.take()
+        {
+            let vals = std::mem::take(&mut self.values);
+            match kind {
+                VtuArray::Points => self.points = Some((vals, array_line)),
+                VtuArray::Radius => self.radii = Some((vals, array_line)),
+                VtuArray::Skip => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// An opening (or self-closing) tag: checked against its parent.
+    fn open(&mut self, tag: &'a str, tag_line: usize) -> Result<()> {
+        let (tag, self_closing) = match tag.strip_suffix('/') {
+            Some(t) => (t, true),
+            None => (tag, false),
+        };
+        let (name, attrs) = parse_tag(VTU, tag_line, tag)?;
+        let attr = |key: &str| vtu_attr(&attrs, key);
+        let parent = self.stack.last().map(|(p, _)| *p);
+        match (name, parent) {
+            ("VTKFile", None) => {
+                if self.seen_file {
+                    return Err(parse_error(VTU, tag_line, "second VTKFile element"));
                 }
-                ("UnstructuredGrid", Some("VTKFile")) => {}
-                ("Piece", Some("UnstructuredGrid")) => {
-                    if npoints.is_some() {
-                        return Err(parse_error(
-                            F,
-                            tag_line,
-                            "more than one Piece is not supported",
-                        ));
-                    }
-                    let n = attr("NumberOfPoints")
-                        .ok_or_else(|| parse_error(F, tag_line, "Piece without NumberOfPoints"))?;
-                    npoints = Some(parse_count(F, tag_line, "NumberOfPoints", n)?);
-                }
-                ("PointData" | "CellData" | "Points" | "Cells", Some("Piece")) => {}
-                ("DataArray", Some(p @ ("PointData" | "CellData" | "Points" | "Cells"))) => {
-                    if attr("format") != Some("ascii") {
-                        return Err(parse_error(
-                            F,
-                            tag_line,
-                            "only format=\"ascii\" data arrays are supported",
-                        ));
-                    }
-                    let float = matches!(attr("type"), Some("Float32" | "Float64"));
-                    let kind = match (p, attr("Name")) {
-                        ("Points", _) => {
-                            if attr("NumberOfComponents") != Some("3") {
-                                return Err(parse_error(
-                                    F,
-                                    tag_line,
-                                    "points need NumberOfComponents=\"3\"",
-                                ));
-                            }
-                            if points.is_some() {
-                                return Err(parse_error(F, tag_line, "second points array"));
-                            }
-                            VtuArray::Points
-                        }
-                        ("PointData", Some("radius")) => {
-                            if radii.is_some() {
-                                return Err(parse_error(F, tag_line, "second radius array"));
-                            }
-                            if attr("NumberOfComponents").is_some_and(|c| c != "1") {
-                                return Err(parse_error(
-                                    F,
-                                    tag_line,
-                                    "the radius array needs 1 component",
-                                ));
-                            }
-                            VtuArray::Radius
-                        }
-                        _ => VtuArray::Skip,
-                    };
-                    if kind != VtuArray::Skip && !float {
-                        return Err(parse_error(
-                            F,
-                            tag_line,
-                            "points and radius must be Float32 or Float64",
-                        ));
-                    }
-                    if !self_closing {
-                        array = Some((kind, tag_line));
-                    } else if kind == VtuArray::Points {
-                        points = Some((Vec::new(), tag_line));
-                    } else if kind == VtuArray::Radius {
-                        radii = Some((Vec::new(), tag_line));
-                    }
-                }
-                _ => {
+                self.seen_file = true;
+                if attr("type") != Some("UnstructuredGrid") {
                     return Err(parse_error(
-                        F,
+                        VTU,
                         tag_line,
-                        format!(
-                            "unexpected element `<{name}>` in `{}`",
-                            parent.unwrap_or("the document")
-                        ),
+                        "not a VTK UnstructuredGrid file",
+                    ));
+                }
+                if attr("compressor").is_some() {
+                    return Err(parse_error(
+                        VTU,
+                        tag_line,
+                        "compressed files are not supported",
                     ));
                 }
             }
-            if !self_closing {
-                stack.push((name, tag_line));
+            ("UnstructuredGrid", Some("VTKFile")) => {}
+            ("Piece", Some("UnstructuredGrid")) => {
+                if self.npoints.is_some() {
+                    return Err(parse_error(
+                        VTU,
+                        tag_line,
+                        "more than one Piece is not supported",
+                    ));
+                }
+                let n = attr("NumberOfPoints")
+                    .ok_or_else(|| parse_error(VTU, tag_line, "Piece without NumberOfPoints"))?;
+                self.npoints = Some(parse_count(VTU, tag_line, "NumberOfPoints", n)?);
             }
-            continue;
+            ("PointData" | "CellData" | "Points" | "Cells", Some("Piece")) => {}
+            ("DataArray", Some(p @ ("PointData" | "CellData" | "Points" | "Cells"))) => {
+                self.data_array(p, &attrs, self_closing, tag_line)?;
+            }
+            _ => {
+                return Err(parse_error(
+                    VTU,
+                    tag_line,
+                    format!(
+                        "unexpected element `<{name}>` in `{}`",
+                        parent.unwrap_or("the document")
+                    ),
+                ));
+            }
         }
-        // Text up to the next tag.
+        if !self_closing {
+            self.stack.push((name, tag_line));
+        }
+        Ok(())
+    }
+
+    /// A `DataArray` in `parent`: ascii only; the points (3 components) and
+    /// the `radius` point array (Float32/Float64, one of each) are read,
+    /// others skipped.
+    fn data_array(
+        &mut self,
+        parent: &str,
+        attrs: &[(&str, &str)],
+        self_closing: bool,
+        tag_line: usize,
+    ) -> Result<()> {
+        let attr = |key: &str| vtu_attr(attrs, key);
+        if attr("format") != Some("ascii") {
+            return Err(parse_error(
+                VTU,
+                tag_line,
+                "only format=\"ascii\" data arrays are supported",
+            ));
+        }
+        let float = matches!(attr("type"), Some("Float32" | "Float64"));
+        let kind = match (parent, attr("Name")) {
+            ("Points", _) => {
+                if attr("NumberOfComponents") != Some("3") {
+                    return Err(parse_error(
+                        VTU,
+                        tag_line,
+                        "points need NumberOfComponents=\"3\"",
+                    ));
+                }
+                if self.points.is_some() {
+                    return Err(parse_error(VTU, tag_line, "second points array"));
+                }
+                VtuArray::Points
+            }
+            ("PointData", Some("radius")) => {
+                if self.radii.is_some() {
+                    return Err(parse_error(VTU, tag_line, "second radius array"));
+                }
+                if attr("NumberOfComponents").is_some_and(|c| c != "1") {
+                    return Err(parse_error(
+                        VTU,
+                        tag_line,
+                        "the radius array needs 1 component",
+                    ));
+                }
+                VtuArray::Radius
+            }
+            _ => VtuArray::Skip,
+        };
+        if kind != VtuArray::Skip && !float {
+            return Err(parse_error(
+                VTU,
+                tag_line,
+                "points and radius must be Float32 or Float64",
+            ));
+        }
+        if !self_closing {
+            self.array = Some((kind, tag_line));
+        } else if kind == VtuArray::Points {
+            self.points = Some((Vec::new(), tag_line));
+        } else if kind == VtuArray::Radius {
+            self.radii = Some((Vec::new(), tag_line));
+        }
+        Ok(())
+    }
+
+    /// Text up to the next tag: values of the array being read; returns
+    /// its length.
+    fn text(&mut self, rest: &str) -> Result<usize> {
         let end = rest.find('<').unwrap_or(rest.len());
         let chunk = &rest[..end];
-        for (l, text_line) in (line..).zip(chunk.split('\n')) {
+        for (l, text_line) in (self.line..).zip(chunk.split('\n')) {
             for tok in text_line.split_whitespace() {
-                match &array {
+                match &self.array {
                     Some((VtuArray::Points | VtuArray::Radius, _)) => {
-                        values.push((parse_finite(F, l, "value", tok)?, l));
+                        self.values.push((parse_finite(VTU, l, "value", tok)?, l));
                     }
                     Some((VtuArray::Skip, _)) => {}
-                    None => return Err(parse_error(F, l, format!("unexpected text `{tok}`"))),
+                    None => return Err(parse_error(VTU, l, format!("unexpected text `{tok}`"))),
                 }
             }
         }
-        line += count_newlines(chunk);
-        pos += end;
+        self.line += count_newlines(chunk);
+        Ok(end)
     }
-    if let Some((open, open_line)) = stack.last() {
-        return Err(parse_error(
-            F,
-            *open_line,
-            format!("`<{open}>` is never closed"),
-        ));
-    }
-    let eof = line + usize::from(!text.ends_with('\n'));
-    let Some(n) = npoints else {
-        return Err(parse_error(F, eof, "no Piece with NumberOfPoints"));
-    };
-    let Some((points, points_line)) = points else {
-        return Err(parse_error(F, eof, "no Points array"));
-    };
-    let Some((radii, radii_line)) = radii else {
-        return Err(parse_error(F, eof, "no `radius` point array"));
-    };
-    if n.checked_mul(3) != Some(points.len()) {
-        return Err(parse_error(
-            F,
-            points_line,
-            format!("{} point coordinates for {n} points", points.len()),
-        ));
-    }
-    if radii.len() != n {
-        return Err(parse_error(
-            F,
-            radii_line,
-            format!("{} radii for {n} points", radii.len()),
-        ));
-    }
-    let mut out = Vec::with_capacity(n);
-    for (p, &(radius, l)) in points.chunks_exact(3).zip(&radii) {
-        if radius <= 0.0 {
+
+    /// At the end of `text`: every element closed, one piece, points and
+    /// radii of the right sizes, positive radii.
+    fn finish(self, text: &str) -> Result<Vec<Sphere>> {
+        if let Some((open, open_line)) = self.stack.last() {
             return Err(parse_error(
-                F,
-                l,
-                format!("radius {radius} is not positive"),
+                VTU,
+                *open_line,
+                format!("`<{open}>` is never closed"),
             ));
         }
-        out.push(Sphere {
-            center: Point3::new(p[0].0, p[1].0, p[2].0),
-            radius,
-        });
+        let eof = self.line + usize::from(!text.ends_with('\n'));
+        let Some(n) = self.npoints else {
+            return Err(parse_error(VTU, eof, "no Piece with NumberOfPoints"));
+        };
+        let Some((points, points_line)) = self.points else {
+            return Err(parse_error(VTU, eof, "no Points array"));
+        };
+        let Some((radii, radii_line)) = self.radii else {
+            return Err(parse_error(VTU, eof, "no `radius` point array"));
+        };
+        if n.checked_mul(3) != Some(points.len()) {
+            return Err(parse_error(
+                VTU,
+                points_line,
+                format!("{} point coordinates for {n} points", points.len()),
+            ));
+        }
+        if radii.len() != n {
+            return Err(parse_error(
+                VTU,
+                radii_line,
+                format!("{} radii for {n} points", radii.len()),
+            ));
+        }
+        let mut out = Vec::with_capacity(n);
+        for (p, &(radius, l)) in points.chunks_exact(3).zip(&radii) {
+            if radius <= 0.0 {
+                return Err(parse_error(
+                    VTU,
+                    l,
+                    format!("radius {radius} is not positive"),
+                ));
+            }
+            out.push(Sphere {
+                center: Point3::new(p[0].0, p[1].0, p[2].0),
+                radius,
+            });
+        }
+        Ok(out)
     }
-    Ok(out)
 }
 
 /// What the values of the `DataArray` being read are for.

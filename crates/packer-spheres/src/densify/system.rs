@@ -1,0 +1,512 @@
+//! The relaxation's state: FIRE velocities and forces, the Verlet
+//! neighbour list with periodic image codes, and the deterministic chunked
+//! sums of the force pass.
+
+use rayon::prelude::*;
+
+use super::DensifyStats;
+use super::geom::Geom;
+use crate::Sphere;
+
+/// Spheres per chunk of the deterministic global sums.
+const CHUNK: usize = 1024;
+/// Bits of a neighbour entry holding the sphere index; the 5 bits above hold the
+/// periodic image (a code in 0..27 of the shift `n · period`, `n ∈ {−1, 0, 1}` per axis).
+const INDEX_BITS: u32 = 27;
+/// Mask of the sphere index in a neighbour entry.
+pub(super) const INDEX_MASK: u32 = (1 << INDEX_BITS) - 1;
+
+/// The 27 image shifts of the neighbour codes.
+fn image_shifts(periods: &[f64; 3]) -> [[f64; 3]; 27] {
+    std::array::from_fn(|code| {
+        let n = [code % 3, (code / 3) % 3, code / 9];
+        std::array::from_fn(|k| (n[k] as f64 - 1.0) * periods[k])
+    })
+}
+
+/// FIRE state and the neighbour list.
+pub(super) struct System {
+    /// Centre and radius of every sphere.
+    pub(super) xr: Vec<[f64; 4]>,
+    v: Vec<[f64; 3]>,
+    f: Vec<[f64; 3]>,
+    pub(super) geom: Geom,
+    /// Neighbour list (CSR, both directions).
+    start: Vec<u32>,
+    list: Vec<u32>,
+    /// Centres at the last build.
+    x_build: Vec<[f64; 3]>,
+    /// Input index of each sphere (the spheres are kept in cell order).
+    pub(super) ids: Vec<u32>,
+    skin: f64,
+    r_max: f64,
+    /// Overlap accepted by the relaxation (absolute).
+    tol: f64,
+    built: bool,
+}
+
+/// Partial sums of one chunk of the force pass.
+#[derive(Clone, Copy)]
+struct Sums {
+    power: f64,
+    ff: f64,
+    vv: f64,
+    worst: f64,
+}
+
+impl System {
+    pub(super) fn new(
+        spheres: &[Sphere],
+        geom: Geom,
+        r_min: f64,
+        r_max: f64,
+        tolerance: f64,
+    ) -> Self {
+        let n = spheres.len();
+        let d_min = 2.0 * r_min;
+        let mut xr: Vec<[f64; 4]> = spheres
+            .iter()
+            .map(|s| [s.center.x, s.center.y, s.center.z, s.radius])
+            .collect();
+        for p in &mut xr {
+            geom.wrap(p);
+        }
+        Self {
+            xr,
+            v: vec![[0.0; 3]; n],
+            f: vec![[0.0; 3]; n],
+            geom,
+            start: Vec::new(),
+            list: Vec::new(),
+            x_build: Vec::new(),
+            ids: (0..n as u32).collect(),
+            skin: 0.25 * d_min,
+            r_max,
+            tol: tolerance * d_min,
+            built: false,
+        }
+    }
+
+    /// Forgets velocities and the neighbour list (after a restore).
+    pub(super) fn reset(&mut self) {
+        self.built = false;
+        for v in &mut self.v {
+            *v = [0.0; 3];
+        }
+    }
+
+    /// Scales centres and domain by `s` about the centre, keeping velocities.
+    pub(super) fn scale_keep(&mut self, s: f64) {
+        let c = self.geom.centre();
+        for p in &mut self.xr {
+            for k in 0..3 {
+                p[k] = c[k] + s * (p[k] - c[k]);
+            }
+        }
+        self.geom = self.geom.scaled(s);
+        self.built = false;
+    }
+
+    /// Scales the domain and the centres by `s` about the domain's centre,
+    /// forgetting the velocities.
+    pub(super) fn compress(&mut self, s: f64) {
+        self.scale_keep(s);
+        self.reset();
+    }
+
+    /// Minimum-image difference `a − b`.
+    #[inline]
+    fn delta(periods: &[f64; 3], a: &[f64], b: &[f64]) -> [f64; 3] {
+        // centres are wrapped at each neighbour build and move less than the skin between
+        // builds, so one period at most separates a difference from its minimum image
+        let mut d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        for k in 0..3 {
+            let p = periods[k];
+            // selects, not branches (p = 0 on walled axes leaves d unchanged)
+            let up = if d[k] > 0.5 * p { p } else { 0.0 };
+            let down = if d[k] < -0.5 * p { p } else { 0.0 };
+            d[k] += down - up;
+        }
+        d
+    }
+
+    /// Builds the neighbour list: pairs closer than `r_i + r_j + skin`.
+    fn build(&mut self) {
+        for p in &mut self.xr {
+            self.geom.wrap(p);
+        }
+        let (lo, hi) = self.geom.bounds();
+        let periods = self.geom.periods();
+        let reach = 2.0 * self.r_max + self.skin;
+        // cells of side >= reach; centres slightly outside a walled domain go to its edge cells
+        let mut dims = [1usize; 3];
+        let mut side = [0.0; 3];
+        for k in 0..3 {
+            let l = hi[k] - lo[k];
+            dims[k] = ((l / reach).floor() as usize).max(1);
+            side[k] = l / dims[k] as f64;
+        }
+        let cell_of = |p: &[f64; 4]| -> [usize; 3] {
+            let mut c = [0usize; 3];
+            for k in 0..3 {
+                let i = ((p[k] - lo[k]) / side[k]).floor();
+                c[k] = if i < 0.0 {
+                    0
+                } else {
+                    (i as usize).min(dims[k] - 1)
+                };
+            }
+            c
+        };
+        let ncell = dims[0] * dims[1] * dims[2];
+        let mut head = vec![0u32; ncell + 1];
+        let cells: Vec<usize> = self
+            .xr
+            .iter()
+            .map(|p| {
+                let c = cell_of(p);
+                (c[2] * dims[1] + c[1]) * dims[0] + c[0]
+            })
+            .collect();
+        for &c in &cells {
+            head[c + 1] += 1;
+        }
+        for i in 0..ncell {
+            head[i + 1] += head[i];
+        }
+        let mut fill = head.clone();
+        let mut order = vec![0u32; self.xr.len()];
+        for (i, &c) in cells.iter().enumerate() {
+            order[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        }
+        // renumber the spheres in cell order (neighbours close in memory); `ids` maps back
+        self.xr = order.iter().map(|&i| self.xr[i as usize]).collect();
+        self.v = order.iter().map(|&i| self.v[i as usize]).collect();
+        self.ids = order.iter().map(|&i| self.ids[i as usize]).collect();
+        let xr = &self.xr;
+        let skin = self.skin;
+        // neighbouring cells along one axis: wrapped on periodic axes, deduplicated when an
+        // axis has fewer than three cells
+        let span = |k: usize, c: usize| -> ([usize; 3], usize) {
+            let n = dims[k] as isize;
+            let mut v = [0usize; 3];
+            let mut m = 0;
+            for o in -1..=1isize {
+                let j = c as isize + o;
+                let j = if periods[k] > 0.0 {
+                    j.rem_euclid(n)
+                } else if j < 0 || j >= n {
+                    continue;
+                } else {
+                    j
+                };
+                if !v[..m].contains(&(j as usize)) {
+                    v[m] = j as usize;
+                    m += 1;
+                }
+            }
+            (v, m)
+        };
+        let lists: Vec<Vec<u32>> = (0..xr.len())
+            .into_par_iter()
+            .map(|i| {
+                let c = cell_of(&xr[i]);
+                let mut out = Vec::with_capacity(24);
+                let (zs, nz) = span(2, c[2]);
+                let (ys, ny) = span(1, c[1]);
+                let (xs, nx) = span(0, c[0]);
+                for &cz in &zs[..nz] {
+                    for &cy in &ys[..ny] {
+                        for &cx in &xs[..nx] {
+                            let cell = (cz * dims[1] + cy) * dims[0] + cx;
+                            for j in head[cell] as usize..head[cell + 1] as usize {
+                                if j == i {
+                                    continue;
+                                }
+                                let d = Self::delta(&periods, &xr[i], &xr[j]);
+                                let cut = xr[i][3] + xr[j][3] + skin;
+                                if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut {
+                                    // the image of j nearest to i, as a shift code
+                                    let mut code = 0u32;
+                                    for k in (0..3).rev() {
+                                        let raw = xr[i][k] - xr[j][k];
+                                        let h = 0.5 * periods[k];
+                                        let n: i32 = if periods[k] > 0.0 && raw > h {
+                                            1
+                                        } else if periods[k] > 0.0 && raw < -h {
+                                            -1
+                                        } else {
+                                            0
+                                        };
+                                        code = 3 * code + (n + 1) as u32;
+                                    }
+                                    out.push(j as u32 | code << INDEX_BITS);
+                                }
+                            }
+                        }
+                    }
+                }
+                out.sort_unstable();
+                out
+            })
+            .collect();
+        self.start.clear();
+        self.list.clear();
+        self.start.push(0);
+        for l in &lists {
+            self.list.extend_from_slice(l);
+            self.start.push(self.list.len() as u32);
+        }
+        self.x_build.clear();
+        self.x_build
+            .extend(self.xr.iter().map(|p| [p[0], p[1], p[2]]));
+        self.built = true;
+    }
+
+    /// Forces into `self.f`, with the chunk sums of `F·v`, `|F|²`, `|v|²` and the largest
+    /// overlap (pairs and walls), added in chunk order.
+    fn forces(&mut self) -> Sums {
+        let shifts = image_shifts(&self.geom.periods());
+        let geom = self.geom;
+        let (xr, v, start, list) = (&self.xr, &self.v, &self.start, &self.list);
+        let parts: Vec<Sums> = self
+            .f
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(c, fs)| {
+                let mut s = Sums {
+                    power: 0.0,
+                    ff: 0.0,
+                    vv: 0.0,
+                    worst: f64::NEG_INFINITY,
+                };
+                for (o, f) in fs.iter_mut().enumerate() {
+                    let i = c * CHUNK + o;
+                    let a = &xr[i];
+                    let (mut acc, ow) = geom.wall(a, a[3]);
+                    let mut worst = ow;
+                    // branch-free, two pairs at a time (the square roots and divisions of
+                    // the two pairs go through the vector units together): half of the
+                    // listed pairs touch, unpredictably
+                    let nb = &list[start[i] as usize..start[i + 1] as usize];
+                    let mut pairs = nb.chunks_exact(2);
+                    let mut acc2 = [[0.0f64; 2]; 3];
+                    let mut worst2 = [f64::NEG_INFINITY; 2];
+                    for jj in &mut pairs {
+                        let (b0, s0) = (
+                            &xr[(jj[0] & INDEX_MASK) as usize],
+                            &shifts[(jj[0] >> INDEX_BITS) as usize],
+                        );
+                        let (b1, s1) = (
+                            &xr[(jj[1] & INDEX_MASK) as usize],
+                            &shifts[(jj[1] >> INDEX_BITS) as usize],
+                        );
+                        let d0 = [
+                            a[0] - b0[0] - s0[0],
+                            a[1] - b0[1] - s0[1],
+                            a[2] - b0[2] - s0[2],
+                        ];
+                        let d1 = [
+                            a[0] - b1[0] - s1[0],
+                            a[1] - b1[1] - s1[1],
+                            a[2] - b1[2] - s1[2],
+                        ];
+                        let dd = [
+                            d0[0] * d0[0] + d0[1] * d0[1] + d0[2] * d0[2],
+                            d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2],
+                        ];
+                        // coincident centres (a broken input) get no force, not a NaN
+                        let dist = [dd[0].sqrt().max(1e-12), dd[1].sqrt().max(1e-12)];
+                        let ov = [a[3] + b0[3] - dist[0], a[3] + b1[3] - dist[1]];
+                        for l in 0..2 {
+                            worst2[l] = if ov[l] > worst2[l] { ov[l] } else { worst2[l] };
+                        }
+                        let k = [
+                            (if ov[0] > 0.0 { ov[0] } else { 0.0 }) / dist[0],
+                            (if ov[1] > 0.0 { ov[1] } else { 0.0 }) / dist[1],
+                        ];
+                        for c in 0..3 {
+                            acc2[c][0] += k[0] * d0[c];
+                            acc2[c][1] += k[1] * d1[c];
+                        }
+                    }
+                    for &j in pairs.remainder() {
+                        let (b, sh) = (
+                            &xr[(j & INDEX_MASK) as usize],
+                            &shifts[(j >> INDEX_BITS) as usize],
+                        );
+                        let d = [
+                            a[0] - b[0] - sh[0],
+                            a[1] - b[1] - sh[1],
+                            a[2] - b[2] - sh[2],
+                        ];
+                        let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-12);
+                        let ov = a[3] + b[3] - dist;
+                        worst2[0] = if ov > worst2[0] { ov } else { worst2[0] };
+                        let k = (if ov > 0.0 { ov } else { 0.0 }) / dist;
+                        for c in 0..3 {
+                            acc2[c][0] += k * d[c];
+                        }
+                    }
+                    for c in 0..3 {
+                        acc[c] += acc2[c][0] + acc2[c][1];
+                    }
+                    worst = worst.max(worst2[0]).max(worst2[1]);
+                    *f = acc;
+                    s.worst = s.worst.max(worst);
+                    let w = &v[i];
+                    s.power += acc[0] * w[0] + acc[1] * w[1] + acc[2] * w[2];
+                    s.ff += acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+                    s.vv += w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+                }
+                s
+            })
+            .collect();
+        let mut t = Sums {
+            power: 0.0,
+            ff: 0.0,
+            vv: 0.0,
+            worst: f64::NEG_INFINITY,
+        };
+        for p in &parts {
+            t.power += p.power;
+            t.ff += p.ff;
+            t.vv += p.vv;
+            t.worst = t.worst.max(p.worst);
+        }
+        t
+    }
+
+    /// FIRE until the largest overlap is at most the tolerance; `false`
+    /// when `max_iter` iterations did not get there.
+    pub(super) fn relax(&mut self, max_iter: usize, stats: &mut DensifyStats) -> bool {
+        const N_MIN: usize = 5;
+        const F_INC: f64 = 1.1;
+        const F_DEC: f64 = 0.5;
+        const ALPHA0: f64 = 0.1;
+        const F_ALPHA: f64 = 0.99;
+        const DT0: f64 = 0.1;
+        const DT_MAX: f64 = 0.5;
+        let mut dt = DT0;
+        let mut alpha = ALPHA0;
+        let mut npos = 0usize;
+        for v in &mut self.v {
+            *v = [0.0; 3];
+        }
+        let lim = 0.25 * self.skin * self.skin;
+        let mut stale = !self.built;
+        for it in 0..=max_iter {
+            if stale || !self.built {
+                self.build();
+                stats.neighbour_builds += 1;
+            }
+            let s = self.forces();
+            if s.worst <= self.tol {
+                return true;
+            }
+            if it == max_iter {
+                break;
+            }
+            stats.iterations += 1;
+            let mix = if s.power > 0.0 {
+                npos += 1;
+                if npos > N_MIN {
+                    dt = (dt * F_INC).min(DT_MAX);
+                    alpha *= F_ALPHA;
+                }
+                Some(if s.ff > 0.0 {
+                    alpha * (s.vv / s.ff).sqrt()
+                } else {
+                    0.0
+                })
+            } else {
+                npos = 0;
+                dt *= F_DEC;
+                alpha = ALPHA0;
+                None
+            };
+            let a = alpha;
+            let periods = self.geom.periods();
+            // velocity mixing, semi-implicit Euler, and whether a centre left half the skin
+            stale = self
+                .v
+                .par_chunks_mut(CHUNK)
+                .zip(self.xr.par_chunks_mut(CHUNK))
+                .zip(self.f.par_chunks(CHUNK))
+                .zip(self.x_build.par_chunks(CHUNK))
+                .map(|(((vs, xs), fs), bs)| {
+                    let mut moved = false;
+                    for (((v, x), f), b) in vs.iter_mut().zip(xs).zip(fs).zip(bs) {
+                        for k in 0..3 {
+                            v[k] = match mix {
+                                Some(m) => (1.0 - a) * v[k] + m * f[k],
+                                None => 0.0,
+                            } + dt * f[k];
+                            x[k] += dt * v[k];
+                        }
+                        let d = Self::delta(&periods, x, b);
+                        moved |= d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > lim;
+                    }
+                    moved
+                })
+                .reduce(|| false, |p, q| p || q);
+        }
+        false
+    }
+
+    /// Scales centres and domain about the centre by the least factor that leaves no
+    /// overlap: `1 + max(ov / d)` over pairs (centre distance `d`) and walls (clearance),
+    /// so every pair and wall gap grows to at least contact.
+    pub(super) fn expand_free(&mut self) {
+        self.build();
+        let periods = self.geom.periods();
+        let geom = self.geom;
+        let (xr, start, list) = (&self.xr, &self.start, &self.list);
+        let delta = (0..xr.len())
+            .into_par_iter()
+            .map(|i| {
+                let a = &xr[i];
+                let mut w = geom.wall_ratio(a, a[3]);
+                for &j in &list[start[i] as usize..start[i + 1] as usize] {
+                    let b = &xr[(j & INDEX_MASK) as usize];
+                    let d = Self::delta(&periods, a, b);
+                    let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    let ov = a[3] + b[3] - dist;
+                    if ov > 0.0 {
+                        w = w.max(ov / dist);
+                    }
+                }
+                w
+            })
+            .reduce(|| 0.0, f64::max);
+        if delta > 0.0 {
+            self.scale_keep((1.0 + delta) * (1.0 + 4.0 * f64::EPSILON));
+        }
+    }
+
+    /// Pairs (and walls) overlapping by more than the tolerance.
+    pub(super) fn overlapping_pairs(&mut self) -> usize {
+        self.build();
+        let periods = self.geom.periods();
+        let mut n = 0;
+        for i in 0..self.xr.len() {
+            let a = self.xr[i];
+            if self.geom.wall(&a, a[3]).1 > self.tol {
+                n += 1;
+            }
+            for &j in &self.list[self.start[i] as usize..self.start[i + 1] as usize] {
+                let j = (j & INDEX_MASK) as usize;
+                if j > i {
+                    let b = &self.xr[j];
+                    let d = Self::delta(&periods, &a, b);
+                    let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    if a[3] + b[3] - dist > self.tol {
+                        n += 1;
+                    }
+                }
+            }
+        }
+        n
+    }
+}
