@@ -636,7 +636,7 @@ impl CloneModel {
     /// [`CloneModel::rasterise_at`] hands to `levelset::Grid::from_star_table`
     /// when `face_cells` is 32 (bit for bit), coarser or finer otherwise.
     /// For packers that keep a compact star-shaped surface instead of a grid
-    /// (e.g. `packer_quadtree::StarGrain::from_table(face_cells, &table)`).
+    /// (e.g. `packer_grains::StarGrain::from_table(face_cells, &table)`).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a radii vector of the wrong length or

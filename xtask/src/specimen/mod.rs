@@ -154,7 +154,7 @@ impl Stages {
             note: String::new(),
         });
     }
-    /// Skips `name` when its output is off (`Some(reason)`), else `None`.
+    /// Whether output `name` is on; when it is off, lists it as skipped ("no `what` asked").
     fn skip_unless(&mut self, on: bool, name: &'static str, what: &str) -> bool {
         if !on {
             self.skip(name, &format!("no {what} asked"));

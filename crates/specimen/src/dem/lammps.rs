@@ -20,7 +20,7 @@ use crate::error::Result;
 pub fn lammps_files(s: &DemSpecimen) -> Result<Vec<(String, Vec<u8>)>> {
     let p = s.plan()?;
     let mut data = Vec::new();
-    write_lammps_clump_data(s, &mut data)?;
+    clump_data(s, &p, &mut data)?;
     let body = body_file(s, &p);
     let rigid = rigid_file(s);
     let deck = settle_deck(s, &p)?;
@@ -41,7 +41,11 @@ pub fn lammps_files(s: &DemSpecimen) -> Result<Vec<(String, Vec<u8>)>> {
 /// # Errors
 /// As [`DemSpecimen::plan`]; [`crate::Error::Io`] when `w` fails.
 pub fn write_lammps_clump_data(s: &DemSpecimen, w: impl std::io::Write) -> Result<()> {
-    let p = s.plan()?;
+    clump_data(s, &s.plan()?, w)
+}
+
+/// [`write_lammps_clump_data`] with the specimen's plan already made (and validated).
+fn clump_data(s: &DemSpecimen, p: &Plan, w: impl std::io::Write) -> Result<()> {
     let (_, _, bounds) = geometry(s.container)?;
     let mut w = std::io::BufWriter::new(w);
     w.write_all(
