@@ -27,6 +27,13 @@
 //!   standard-deviation errors (the seed's criterion over both tables); if
 //!   none meets the targets, that sum alone.
 //!
+//! Timing: each configuration clones without outputs (a level set only where
+//! its roundness check is `LevelSet`), timed as the *clone rate* (what a
+//! specimen's clone stage pays); the clones are then scored on their
+//! rasterised 45³ level sets (`CloneModel::measure_dna`, the same DNA a run
+//! with the DNA output stores, bit for bit), timed separately. `--check`
+//! prints both and the rate of the two together.
+//!
 //! `--check` re-runs a committed configuration (the Ottawa fixture, or
 //! `--out FILE` with `--parents`) and fails unless it reproduces the
 //! committed scores (runs are deterministic).
@@ -133,7 +140,10 @@ struct Outcome {
     steering: String,
     scores: Scores,
     stats: RunStats,
+    /// Wall time of the cloning (the clone rate's denominator).
     wall_s: f64,
+    /// Wall time of scoring: the clones' level sets and their DNA.
+    score_s: f64,
     dna: DnaTable,
 }
 
@@ -240,6 +250,46 @@ fn sweep(seed: u64) -> Vec<Config> {
             },
         });
     }
+    // the roundness check by the surface prediction alone (no level set in
+    // the cloning): the predicted miss held within the tolerance; the
+    // prediction and the roundness pull are fitted on the pilot clones, so
+    // more pilots (fit-time only) are part of the sweep
+    for (rt, pred, margin, pilots) in [
+        (0.03, 2, 0.25, 96),
+        (0.03, 4, 0.25, 96),
+        (0.02, 4, 0.25, 96),
+        (0.03, 4, 0.5, 96),
+        (0.015, 4, 0.5, 96),
+        (0.03, 2, 0.25, 192),
+        (0.03, 4, 0.25, 192),
+        (0.02, 4, 0.25, 192),
+        (0.03, 4, 0.5, 192),
+    ] {
+        let pc = if pilots == 96 {
+            String::new()
+        } else {
+            format!("-pc{pilots}")
+        };
+        out.push(Config {
+            name: format!(
+                "m28x18-b50-ls45-tol15-rp{:.0}-pred{pred}m{:.0}{pc}",
+                1000.0 * rt,
+                100.0 * margin
+            ),
+            trial: None,
+            params: Params {
+                tolerance: 0.15,
+                roundness_tolerance: Some(rt),
+                roundness_check: cloner::RoundnessCheck::Predicted,
+                roundness_repairs: 0,
+                roundness_predictions: pred,
+                roundness_prediction_margin: margin,
+                pilot_clones: pilots,
+                seed,
+                ..Params::default()
+            },
+        });
+    }
     out.push(Config {
         name: "m28x18-b50-ls45-seed-methods".into(),
         trial: Some(4),
@@ -257,7 +307,18 @@ fn run_config(
     clones: u64,
     quiet: bool,
 ) -> anyhow::Result<Outcome> {
-    let model = CloneModel::fit(parents, &config.params)
+    // the clones are made without outputs (a level set only where the
+    // configuration's roundness check needs one) and scored afterwards on
+    // their rasterised level sets, so the clone rate is what a specimen pays;
+    // the DNA is the one a run with outputs stores (bit for bit)
+    let run_params = Params {
+        outputs: cloner::Outputs {
+            level_set: false,
+            dna: false,
+        },
+        ..config.params
+    };
+    let model = CloneModel::fit(parents, &run_params)
         .with_context(|| format!("fitting {}", config.name))?;
     let clock = InstantClock(Instant::now());
     let pb = progress::bar(&config.name, clones, quiet);
@@ -273,11 +334,15 @@ fn run_config(
         )
         .with_context(|| format!("cloning {}", config.name))?;
     let wall_s = start.elapsed().as_secs_f64();
-    let dna = run.dna_table()?;
+    let scoring = Instant::now();
+    let dna = model
+        .measure_dna(&run.clones)
+        .with_context(|| format!("measuring the clones of {}", config.name))?;
+    let score_s = scoring.elapsed().as_secs_f64();
     let mut steering = String::from(
         "index,attempts,target_aspect_ratio,target_min_dimension,target_flatness,target_roundness,target_vs,steer_roundness,surface_aspect_ratio,surface_min_dimension,surface_roundness,surface_vs,measured_aspect_ratio,measured_diameter,measured_roundness,measured_vs,measured_min_dimension\n",
     );
-    for c in &run.clones {
+    for (k, c) in run.clones.iter().enumerate() {
         let t = &c.targets;
         let s = &c.surface;
         let _ = write!(
@@ -296,7 +361,7 @@ fn run_config(
             s.roundness,
             s.volume_surface_ratio()
         );
-        for v in c.dna.iter().flatten() {
+        for v in dna.row(k).unwrap_or_default() {
             let _ = write!(steering, ",{v}");
         }
         steering.push('\n');
@@ -309,6 +374,7 @@ fn run_config(
         scores,
         stats: run.stats,
         wall_s,
+        score_s,
         dna,
     })
 }
@@ -478,7 +544,7 @@ fn md_chosen(md: &mut String, b: &Outcome) {
     let ms = |ns: u64| ns as f64 * 1e-6 / st.accepted.max(1) as f64;
     let _ = writeln!(
         md,
-        "Candidates: {} for {} clones (acceptance {:.1} %); rejected: {} too round (after sharpening), {} roundness not reached, {} V/S quality control, {} measured roundness, {} degenerate, {} target unavailable. Polishing steps per candidate: {:.1}; re-steered roundness repairs: {}; predicted-roundness passes: {}; level sets per accepted clone: {:.2}.\n\nStage time per accepted clone (ms): targets {:.3}, radii {:.3}, polishing {:.3}, quality control {:.3}, rasterisation {:.3}, DNA {:.3}.\n",
+        "Candidates: {} for {} clones (acceptance {:.1} %); rejected: {} too round (after sharpening), {} roundness not reached, {} V/S quality control, {} measured roundness, {} predicted roundness, {} degenerate, {} target unavailable. Polishing steps per candidate: {:.1}; re-steered roundness repairs: {}; predicted-roundness passes: {}; level sets per accepted clone: {:.2}.\n\nStage time per accepted clone (ms): targets {:.3}, radii {:.3}, polishing {:.3}, quality control {:.3}, rasterisation {:.3}, DNA {:.3}.\n",
         st.attempts,
         st.accepted,
         100.0 * st.acceptance_rate(),
@@ -486,6 +552,7 @@ fn md_chosen(md: &mut String, b: &Outcome) {
         r.roundness_unreached,
         r.quality_control,
         r.measured_roundness,
+        r.predicted_roundness,
         r.degenerate,
         r.target_unavailable,
         st.polishing_steps as f64 / st.attempts.max(1) as f64,
@@ -1001,14 +1068,36 @@ impl Calibrate {
             );
         }
         println!(
-            "{shown} reproduced: {} clones of `{}`, avg mean error {:.2} %, avg std error {:.2} %, max KS {:.3}, {:.0} accepted clones/s",
+            "{shown} reproduced: {} clones of `{}`, avg mean error {:.2} %, avg std error {:.2} %, max KS {:.3}, {:.0} accepted clones/s (scored in {:.2} s: their level sets and DNA; {:.0} clones/s cloned and scored)",
             cal.clones,
             cal.name,
             b.mean_error_avg_pct,
             b.std_error_avg_pct,
             b.ks_max,
-            o.stats.accepted as f64 / o.wall_s
+            o.stats.accepted as f64 / o.wall_s,
+            o.score_s,
+            o.stats.accepted as f64 / (o.wall_s + o.score_s)
         );
+        println!("{}", stage_line(&o.stats));
         Ok(())
     }
+}
+
+/// One line of the run's cost per accepted clone: candidates, level sets and
+/// CPU per stage (ms).
+fn stage_line(st: &RunStats) -> String {
+    let per = st.accepted.max(1) as f64;
+    let ms = |ns: u64| ns as f64 * 1e-6 / per;
+    format!(
+        "per accepted clone: {:.2} candidates, {:.2} level sets; CPU ms: targets {:.3}, radii {:.3}, polishing {:.3}, quality control {:.3}, rasterisation {:.3}, DNA {:.3} (total {:.3})",
+        st.attempts as f64 / per,
+        st.level_sets as f64 / per,
+        ms(st.times.targets_ns),
+        ms(st.times.radii_ns),
+        ms(st.times.polishing_ns),
+        ms(st.times.quality_ns),
+        ms(st.times.rasterise_ns),
+        ms(st.times.measure_ns),
+        ms(st.times.total_ns()),
+    )
 }

@@ -65,11 +65,12 @@ pub enum Error {
     },
     /// A clone index could not be accepted within the attempt limit.
     #[error(
-        "clone {index}: no candidate accepted in {attempts} attempts (rejected: {} too round, {} roundness not reached, {} V/S quality control, {} measured roundness, {} degenerate, {} target unavailable)",
+        "clone {index}: no candidate accepted in {attempts} attempts (rejected: {} too round, {} roundness not reached, {} V/S quality control, {} measured roundness, {} predicted roundness, {} degenerate, {} target unavailable)",
         rejections.too_round,
         rejections.roundness_unreached,
         rejections.quality_control,
         rejections.measured_roundness,
+        rejections.predicted_roundness,
         rejections.degenerate,
         rejections.target_unavailable
     )]

@@ -11,8 +11,9 @@
 //! ([`RadiiModel`]). [`CloneModel::run`] then clones an index range in
 //! parallel: embryo ellipsoid from the sampled aspect ratio and minimum
 //! principal dimension, correlated node radii, Laplacian polishing to the
-//! sampled roundness, the volume/surface quality control, and — only for
-//! accepted candidates and only if asked for ([`Outputs`]) — the level set
+//! sampled roundness, the volume/surface quality control, the roundness
+//! check, and — only for accepted candidates and only if asked for
+//! ([`Outputs`]) — the level set
 //! (`levelset::Grid::from_star`) and its measured DNA. The stages and their
 //! rejection order are documented in [`pipeline`].
 //!
@@ -45,6 +46,17 @@
 //!   predicted-roundness passes (`Params::roundness_predictions`) re-steer
 //!   before the level set is built, from a pilot-fitted prediction that adds
 //!   the estimated inscribed radius to the surface roundness.
+//! * **Roundness checked on the surface** ([`RoundnessCheck::Predicted`],
+//!   the committed Ottawa calibration since issue 30): the check holds the
+//!   *predicted* level-set roundness — least squares on the pilot clones'
+//!   level sets of the surface roundness computed about the estimated
+//!   inscribed radius, as `morph-dna` computes it about the level set's — to
+//!   the target pulled towards the parents' mean by the prediction's
+//!   residual, so a clone needs no level set at all (≈ 0.1 ms of surface
+//!   measures instead of a 45³ level set and its roundness, ≈ 6 ms). The
+//!   level-set check ([`RoundnessCheck::LevelSet`]) stays selectable. A run
+//!   rasterises only what its [`Outputs`] ask for; a calibration scores its
+//!   clones afterwards ([`CloneModel::measure_dna`]), outside the cloning.
 //! * **Seed methods kept.** [`Params::seed_faithful`] selects the seed's
 //!   pairwise-PDF targets, neighbourhood-averaged radii, bilinear
 //!   interpolation and untouched embryo axes, for comparison.
@@ -119,7 +131,7 @@ pub use model::{
     grid_from_mesh, grid_from_sh,
 };
 pub use output::{Format, write_grid};
-pub use params::{Outputs, Params, RadiiModel, Smoothing, TargetModel};
+pub use params::{Outputs, Params, RadiiModel, RoundnessCheck, Smoothing, TargetModel};
 pub use pipeline::{
     Clock, ClonedGrain, Hooks, NoClock, Progress, Rejections, Run, RunStats, StageTimes, clone_rng,
     shard_range,

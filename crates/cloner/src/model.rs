@@ -15,7 +15,7 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::params::{Params, RadiiModel, TargetModel};
+use crate::params::{Params, RadiiModel, RoundnessCheck, TargetModel};
 use crate::surface::{DirectionPlan, MeshGeometry, SurfaceDna};
 
 /// The DNA measured on every parent and on every clone, in this order:
@@ -362,6 +362,14 @@ impl SteeringMap {
         }
     }
 
+    /// The measured-space target `m*` of descriptor `k` ([`TARGETS`] order)
+    /// pulled towards the parents' mean (`mean + shrink · (m* − mean)`),
+    /// before the affine map: what a check in measured space compares
+    /// with.
+    pub fn pulled(&self, k: usize, measured: f64) -> f64 {
+        self.parent_mean[k] + self.shrink[k] * (measured - self.parent_mean[k])
+    }
+
     /// The surface-measure target of a measured-space target.
     pub fn steer(&self, measured: &Targets) -> Targets {
         let m = measured.to_array();
@@ -376,16 +384,28 @@ impl SteeringMap {
 
 /// One pilot clone: its surface DNA and measured DNA (target order) and its
 /// estimated inscribed radius over the surface `r_min`.
-type PilotSample = ([f64; 5], [f64; 5], f64);
+/// The last entry is the surface roundness about the estimated inscribed
+/// radius ([`MeshGeometry::roundness_about`]), the predictor of
+/// `RoundnessCheck::Predicted`.
+type PilotSample = ([f64; 5], [f64; 5], f64, f64);
 
 /// Least squares `R ≈ c₀ + c₁ R_surface + c₂ ρ` over pilot clones
 /// `(surface DNA, measured DNA, ρ = r_ins / r_min)` (roundness at index 3),
 /// and its residual standard deviation; `None` for fewer than 8 finite
 /// triples, a singular system or `c₁ ≤ 0.05`.
-fn fit_roundness_prediction(triples: &[PilotSample]) -> (Option<[f64; 3]>, f64) {
+fn fit_roundness_prediction(
+    triples: &[PilotSample],
+    check: RoundnessCheck,
+) -> (Option<[f64; 3]>, f64) {
     let rows: Vec<([f64; 3], f64)> = triples
         .iter()
-        .map(|(s, m, rho)| ([1.0, s[3], *rho], m[3]))
+        .map(|(s, m, rho, about)| {
+            let r_surface = match check {
+                RoundnessCheck::LevelSet => s[3],
+                RoundnessCheck::Predicted => *about,
+            };
+            ([1.0, r_surface, *rho], m[3])
+        })
         .filter(|(x, y)| x.iter().all(|v| v.is_finite()) && y.is_finite())
         .collect();
     if rows.len() < 8 {
@@ -608,6 +628,16 @@ impl CloneModel {
         if params.pilot_clones > 0 {
             model.map = model.fit_steering_map(parent_mean, parent_sd)?;
         }
+        if params.roundness_check == RoundnessCheck::Predicted
+            && params.roundness_tolerance.is_some()
+            && model.map.roundness_prediction.is_none()
+        {
+            return Err(Error::InvalidParameter {
+                name: "roundness_check",
+                value: model.map.pilot_clones as f64,
+                reason: "Predicted: the pilot clones gave no roundness prediction (too few, or their surface roundness does not predict the measured one); use LevelSet",
+            });
+        }
         Ok(model)
     }
 
@@ -639,12 +669,19 @@ impl CloneModel {
                 let d = c.dna.unwrap_or_default();
                 let meas =
                     std::array::from_fn(|t| d.get(TARGET_IN_DNA[t]).copied().unwrap_or(f64::NAN));
-                let ins = self.geom.inscribed_radius(&c.radii).unwrap_or(f64::NAN) / s.r_min;
-                Ok((surf, meas, ins))
+                let r_ins = self.geom.inscribed_radius(&c.radii).unwrap_or(f64::NAN);
+                let (res, margin) = (self.params.level_set_resolution, self.params.grid_margin);
+                let about = match self.params.roundness_check {
+                    RoundnessCheck::LevelSet => f64::NAN,
+                    RoundnessCheck::Predicted => {
+                        self.geom.roundness_about(&c.radii, res, margin, r_ins)
+                    }
+                };
+                Ok((surf, meas, r_ins / s.r_min, about))
             })
             .collect();
         let pairs = samples.into_iter().collect::<Result<Vec<_>>>()?;
-        let (prediction, prediction_sd) = fit_roundness_prediction(&pairs);
+        let (prediction, prediction_sd) = fit_roundness_prediction(&pairs, self.params.roundness_check);
         let mut map = SteeringMap::identity(parent_mean);
         map.pilot_clones = pairs.len();
         map.roundness_prediction = prediction;
@@ -676,7 +713,15 @@ impl CloneModel {
             if t == 3
                 && let Some(rt) = self.params.roundness_tolerance
             {
-                res = res.min(rt / 3f64.sqrt());
+                res = match self.params.roundness_check {
+                    RoundnessCheck::LevelSet => res.min(rt / 3f64.sqrt()),
+                    // the surface check truncates the predicted roundness to
+                    // ±margin·tolerance; the prediction's own residual adds
+                    RoundnessCheck::Predicted => {
+                        let w = self.params.roundness_prediction_margin * rt;
+                        res.min((prediction_sd * prediction_sd + w * w / 3.0).sqrt())
+                    }
+                };
             }
             map.offset[t] = offset;
             map.slope[t] = slope;
@@ -714,6 +759,22 @@ impl CloneModel {
     /// Every parent's radii at the mesh nodes (principal frame).
     pub fn parent_profiles(&self) -> &[Vec<f64>] {
         &self.profiles
+    }
+
+    /// One production draw of a candidate's targets, as [`CloneModel::run`]
+    /// draws them: `(targets in the parents' measure, steering targets in
+    /// surface measure)`; `None` when the draw found a conditional slice
+    /// without mass (the run draws again). For stage benches and studies of
+    /// the target model.
+    pub fn draw_targets(&self, rng: &mut impl Rng) -> Option<(Targets, Targets)> {
+        self.sample_targets(Mode::Production, rng).ok()
+    }
+
+    /// One draw of a candidate's normalised node radii (ratios to the
+    /// embryo ellipsoid, flat node order of the mesh) into `out`, as
+    /// [`CloneModel::run`] draws them.
+    pub fn draw_radii(&self, rng: &mut impl Rng, out: &mut Vec<f64>) {
+        self.sample_radii(rng, out);
     }
 
     /// Draws the targets of one candidate: `(measured-space targets,

@@ -27,6 +27,25 @@ pub enum TargetModel {
     Copula,
 }
 
+/// Where the roundness check (`Params::roundness_tolerance`) measures a
+/// candidate's roundness.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum RoundnessCheck {
+    /// On the candidate's rasterised level set, exactly as the clone is
+    /// judged (`morph_dna::measure`): one level set and its roundness per
+    /// checked candidate, with `roundness_repairs` re-steered repairs.
+    #[default]
+    LevelSet,
+    /// By the roundness predicted from the candidate's surface DNA and its
+    /// estimated inscribed radius (`SteeringMap::roundness_prediction`,
+    /// least squares on the pilot clones' level sets): after the
+    /// `roundness_predictions` re-steered passes, a candidate whose
+    /// predicted miss exceeds the tolerance is rejected. No level set is
+    /// built unless the outputs ask for one. Needs `pilot_clones` and
+    /// `roundness_predictions > 0`.
+    Predicted,
+}
+
 /// How the radii of the mesh nodes are drawn (normalised by the embryo
 /// ellipsoid's radius in the node's direction).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -131,6 +150,12 @@ pub struct Params {
     /// Largest |measured − target| roundness of an accepted clone, checked on
     /// its level set (`None` = the surface-DNA steering alone, the default).
     pub roundness_tolerance: Option<f64>,
+    /// Where the roundness check of `roundness_tolerance` measures a
+    /// candidate: on its rasterised level set (the default, as calibrated
+    /// before) or by the pilot-fitted prediction from its surface
+    /// ([`RoundnessCheck::Predicted`]), which builds no level set.
+    #[serde(default)]
+    pub roundness_check: RoundnessCheck,
     /// With `roundness_tolerance`: re-steered polishing passes of a candidate
     /// whose measured roundness misses (the same raw field polished again
     /// toward a surface roundness moved against the miss, then quality
@@ -183,6 +208,7 @@ impl Default for Params {
             axis_corrections: 2,
             pilot_clones: 96,
             roundness_tolerance: None,
+            roundness_check: RoundnessCheck::LevelSet,
             roundness_repairs: 0,
             roundness_predictions: 0,
             roundness_prediction_margin: default_prediction_margin(),
@@ -297,6 +323,16 @@ impl Params {
             && !(t.is_finite() && t > 0.0 && t < 1.0)
         {
             return bad("roundness_tolerance", t, "in (0, 1)");
+        }
+        if self.roundness_check == RoundnessCheck::Predicted
+            && self.roundness_tolerance.is_some()
+            && (self.pilot_clones == 0 || self.roundness_predictions == 0)
+        {
+            return bad(
+                "roundness_check",
+                self.pilot_clones as f64,
+                "Predicted needs pilot_clones > 0 and roundness_predictions > 0 (the prediction is fitted on the pilot)",
+            );
         }
         if self.roundness_repairs > 16 {
             return bad(

@@ -68,7 +68,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::model::{CloneModel, DNA, Mode, Targets};
-use crate::params::Outputs;
+use crate::params::{Outputs, RoundnessCheck};
 pub use crate::rejections::Rejections;
 use crate::surface::SurfaceDna;
 
@@ -133,6 +133,7 @@ impl Rejections {
             Reject::Degenerate => self.degenerate += 1,
             Reject::QualityControl => self.quality_control += 1,
             Reject::MeasuredRoundness => self.measured_roundness += 1,
+            Reject::PredictedRoundness => self.predicted_roundness += 1,
         }
     }
 
@@ -143,6 +144,7 @@ impl Rejections {
         self.degenerate += o.degenerate;
         self.quality_control += o.quality_control;
         self.measured_roundness += o.measured_roundness;
+        self.predicted_roundness += o.predicted_roundness;
     }
 }
 
@@ -306,6 +308,34 @@ impl Run {
     }
 }
 
+impl CloneModel {
+    /// The [`DNA`] of each clone measured on its level set at the model's
+    /// resolution ([`CloneModel::rasterise`], then `morph_dna::measure`, in
+    /// parallel): the values a run with [`crate::Outputs::dna`] stores, bit
+    /// for bit, for clones made without them (a calibration scores its clones
+    /// this way, outside the cloning it times). Rows in the order of `clones`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for radii of the wrong length or not
+    /// finite and positive; level-set and measurement errors of the first
+    /// failing clone.
+    pub fn measure_dna(&self, clones: &[ClonedGrain]) -> Result<DnaTable> {
+        let rows: Vec<Result<Vec<f64>>> = clones
+            .par_iter()
+            .map(|c| {
+                let g = self.rasterise(&c.radii)?;
+                let mut m = Measurement::owned(g, &MeasureParams::default())?;
+                Ok(m.get(&DNA)?)
+            })
+            .collect();
+        let mut t = DnaTable::new(DNA.to_vec())?;
+        for r in rows {
+            t.push_row(&r?)?;
+        }
+        Ok(t)
+    }
+}
+
 /// The index range of shard `k` of `n` (1-based) of `0..total`: contiguous,
 /// the first `total mod n` shards one longer. Shards together are exactly
 /// `0..total`, so a sharded run equals the unsharded one.
@@ -338,6 +368,7 @@ enum Reject {
     Degenerate,
     QualityControl,
     MeasuredRoundness,
+    PredictedRoundness,
 }
 
 struct Candidate {
@@ -703,10 +734,45 @@ impl CloneModel {
         )
     }
 
+    /// The predicted level-set roundness of `cand` minus its target
+    /// (`SteeringMap::roundness_prediction` `pred`: the surface roundness and
+    /// the estimated inscribed radius); `None` when the inscribed radius
+    /// cannot be estimated. Timed as quality control.
+    fn predicted_miss(
+        &self,
+        cand: &Candidate,
+        pred: [f64; 3],
+        stats: &mut RunStats,
+        clock: &dyn Clock,
+    ) -> Option<f64> {
+        let t0 = clock.now_ns();
+        let ins = self.geom.inscribed_radius(&cand.radii);
+        let r_surface = match (self.params.roundness_check, ins) {
+            (RoundnessCheck::Predicted, Some(r_ins)) => {
+                let p = &self.params;
+                self.geom
+                    .roundness_about(&cand.radii, p.level_set_resolution, p.grid_margin, r_ins)
+            }
+            _ => cand.surface.roundness,
+        };
+        stats.times.quality_ns += clock.now_ns() - t0;
+        let predicted = pred[0] + pred[1] * r_surface + pred[2] * ins? / cand.surface.r_min;
+        // the surface check holds the prediction to the pulled target (the
+        // prediction's residual then restores the parents' spread); the
+        // level-set check's passes aim at the target itself, as calibrated
+        let target = match self.params.roundness_check {
+            RoundnessCheck::LevelSet => cand.targets.roundness,
+            RoundnessCheck::Predicted => self.map.pulled(3, cand.targets.roundness),
+        };
+        let miss = predicted - target;
+        miss.is_finite().then_some(miss)
+    }
+
     /// Predicted-roundness passes (`Params::roundness_predictions`): re-steers
     /// `cand` before any level set while the roundness predicted from its
     /// surface DNA and inscribed radius misses its target by more than the
-    /// margin (a fraction of the tolerance `t`).
+    /// margin (a fraction of the tolerance `t`). Returns the predicted miss
+    /// of the candidate as it leaves (`None` if it cannot be predicted).
     fn predicted_roundness_passes(
         &self,
         cand: &mut Candidate,
@@ -715,18 +781,11 @@ impl CloneModel {
         s: &mut Scratch,
         stats: &mut RunStats,
         clock: &dyn Clock,
-    ) {
+    ) -> Option<f64> {
+        let margin = self.params.roundness_prediction_margin * t;
+        let mut miss = self.predicted_miss(cand, pred, stats, clock)?;
         for _ in 0..self.params.roundness_predictions {
-            let t0 = clock.now_ns();
-            let ins = self.geom.inscribed_radius(&cand.radii);
-            stats.times.quality_ns += clock.now_ns() - t0;
-            let Some(ins) = ins else { break };
-            let predicted =
-                pred[0] + pred[1] * cand.surface.roundness + pred[2] * ins / cand.surface.r_min;
-            let miss = predicted - cand.targets.roundness;
-            // (a NaN miss ends the passes too)
-            let margin = self.params.roundness_prediction_margin * t;
-            if miss.abs().partial_cmp(&margin) != Some(std::cmp::Ordering::Greater) {
+            if miss.abs() <= margin {
                 break;
             }
             stats.roundness_predictions += 1;
@@ -736,7 +795,9 @@ impl CloneModel {
                 Ok(c) => *cand = c,
                 Err(_) => break,
             }
+            miss = self.predicted_miss(cand, pred, stats, clock)?;
         }
+        Some(miss)
     }
 
     /// The candidate's level set and, with a roundness tolerance
@@ -841,10 +902,21 @@ impl CloneModel {
                 (Mode::Production, Some(t)) => Some(t),
                 _ => None,
             };
-            let measure_dna = outputs.dna || check_roundness.is_some();
             if let (Some(t), Some(pred)) = (check_roundness, self.map.roundness_prediction) {
-                self.predicted_roundness_passes(&mut cand, t, pred, &mut s, &mut stats, clock);
+                let miss =
+                    self.predicted_roundness_passes(&mut cand, t, pred, &mut s, &mut stats, clock);
+                if self.params.roundness_check == RoundnessCheck::Predicted
+                    && !miss.is_some_and(|m| m.abs() <= t)
+                {
+                    stats.rejections.count(Reject::PredictedRoundness);
+                    continue;
+                }
             }
+            let check_roundness = match self.params.roundness_check {
+                RoundnessCheck::LevelSet => check_roundness,
+                RoundnessCheck::Predicted => None,
+            };
+            let measure_dna = outputs.dna || check_roundness.is_some();
             if outputs.level_set || measure_dna {
                 let g =
                     self.checked_level_set(&mut cand, check_roundness, &mut s, &mut stats, clock);

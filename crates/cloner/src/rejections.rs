@@ -19,6 +19,10 @@ pub struct Rejections {
     /// The roundness measured on the level set missed its target by more
     /// than `roundness_tolerance`.
     pub measured_roundness: u64,
+    /// The roundness predicted from the surface missed its target by more
+    /// than `roundness_tolerance` (`RoundnessCheck::Predicted`).
+    #[serde(default)]
+    pub predicted_roundness: u64,
 }
 
 impl Rejections {
@@ -30,5 +34,6 @@ impl Rejections {
             + self.degenerate
             + self.quality_control
             + self.measured_roundness
+            + self.predicted_roundness
     }
 }

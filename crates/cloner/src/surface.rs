@@ -391,7 +391,16 @@ impl MeshGeometry {
     /// Roundness estimate only (see the module docs); `resolution` is the
     /// level-set nodes per axis and `margin` the grid half-width over `r_max`.
     pub fn roundness(&self, r: &[f64], resolution: usize, margin: f64) -> f64 {
-        let (r_min, r_max) = min_max(r);
+        let (r_min, _) = min_max(r);
+        self.roundness_about(r, resolution, margin, r_min)
+    }
+
+    /// As [`MeshGeometry::roundness`] with the inscribed radius `r_ins`
+    /// instead of `min r` in the corner rule (κ₁ > 1/r_ins) and as the
+    /// scale, as `morph-dna` measures it on a level set (e.g. `r_ins` from
+    /// [`MeshGeometry::inscribed_radius`]).
+    pub fn roundness_about(&self, r: &[f64], resolution: usize, margin: f64, r_ins: f64) -> f64 {
+        let (r_min, r_max) = (r_ins, min_max(r).1);
         let cap = (resolution.saturating_sub(1)) as f64 / (2.0 * margin * r_max);
         let threshold = 1.0 / r_min;
         let (mut sw, mut swk) = (0.0, 0.0);

@@ -650,3 +650,92 @@ fn a_mesh_grain_is_rasterised_about_its_centroid() {
         Err(Error::InvalidParameter { .. })
     ));
 }
+
+/// `RoundnessCheck::Predicted`: no level set in the cloning, every clone's
+/// predicted roundness within the tolerance of its pulled target, the same
+/// clones for any thread count, the DNA measured afterwards
+/// ([`CloneModel::measure_dna`]) bit for bit that of a run with the DNA
+/// output, and the check refused without a pilot to fit its prediction.
+#[test]
+fn the_predicted_roundness_check_builds_no_level_set() {
+    use crate::params::RoundnessCheck;
+    let tol = 0.03;
+    let base = Params {
+        roundness_tolerance: Some(tol),
+        roundness_check: RoundnessCheck::Predicted,
+        roundness_predictions: 2,
+        outputs: Outputs {
+            level_set: false,
+            dna: false,
+        },
+        ..small_params()
+    };
+    let model = CloneModel::fit(parents(), &base).expect("model");
+    let a = in_pool(1, || model.run(0..8, Hooks::default()).expect("run"));
+    let b = in_pool(2, || model.run(0..8, Hooks::default()).expect("run"));
+    assert_eq!(a.clones, b.clones);
+    assert_eq!(a.stats, b.stats);
+    assert_eq!(a.stats.level_sets, 0);
+    assert!(a.clones.iter().all(|c| c.grid.is_none() && c.dna.is_none()));
+    let map = model.steering_map();
+    let pred = map.roundness_prediction.expect("fitted");
+    let (res, margin) = (base.level_set_resolution, base.grid_margin);
+    for c in &a.clones {
+        let geom = model.geometry();
+        let ins = geom.inscribed_radius(&c.radii).expect("r_ins");
+        let r = geom.roundness_about(&c.radii, res, margin, ins);
+        let predicted = pred[0] + pred[1] * r + pred[2] * ins / c.surface.r_min;
+        let miss = predicted - map.pulled(3, c.targets.roundness);
+        assert!(miss.abs() <= tol, "clone {}: predicted miss {miss}", c.index);
+    }
+    // the DNA afterwards is the DNA output of the same clones
+    let with_dna = CloneModel::fit(
+        parents(),
+        &Params {
+            outputs: Outputs {
+                level_set: false,
+                dna: true,
+            },
+            ..base
+        },
+    )
+    .expect("model");
+    let c = with_dna.run(0..8, Hooks::default()).expect("run");
+    assert_eq!(c.stats.level_sets, 8);
+    assert_eq!(
+        a.clones.iter().map(|x| &x.radii).collect::<Vec<_>>(),
+        c.clones.iter().map(|x| &x.radii).collect::<Vec<_>>()
+    );
+    let later = model.measure_dna(&a.clones).expect("dna");
+    let during = c.dna_table().expect("table");
+    for k in 0..8 {
+        let (x, y) = (later.row(k).expect("row"), during.row(k).expect("row"));
+        assert!(x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()));
+    }
+    // no pilot, no prediction: refused
+    for p in [
+        Params {
+            pilot_clones: 0,
+            ..base
+        },
+        Params {
+            roundness_predictions: 0,
+            ..base
+        },
+    ] {
+        assert!(matches!(
+            CloneModel::fit(parents(), &p),
+            Err(Error::InvalidParameter {
+                name: "roundness_check",
+                ..
+            })
+        ));
+    }
+    // a clone with a bad radius is refused by the measurement, not measured
+    let mut bad = a.clones[0].clone();
+    bad.radii[3] = f64::NAN;
+    assert!(matches!(
+        model.measure_dna(&[bad]),
+        Err(Error::InvalidParameter { name: "radii", .. })
+    ));
+}
