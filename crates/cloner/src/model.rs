@@ -432,6 +432,21 @@ fn fit_roundness_prediction(
     (Some([c[0], c[1], c[2]]), sd)
 }
 
+/// A surface roundness check needs the pilot's roundness prediction.
+fn predicted_check_ready(params: &Params, map: &SteeringMap) -> Result<()> {
+    if params.roundness_check == RoundnessCheck::Predicted
+        && params.roundness_tolerance.is_some()
+        && map.roundness_prediction.is_none()
+    {
+        return Err(Error::InvalidParameter {
+            name: "roundness_check",
+            value: map.pilot_clones as f64,
+            reason: "Predicted: the pilot clones gave no roundness prediction (too few, or their surface roundness does not predict the measured one); use LevelSet",
+        });
+    }
+    Ok(())
+}
+
 fn check_spread(what: &'static str, x: &[f64]) -> Result<()> {
     let (lo, hi) = x
         .iter()
@@ -628,16 +643,7 @@ impl CloneModel {
         if params.pilot_clones > 0 {
             model.map = model.fit_steering_map(parent_mean, parent_sd)?;
         }
-        if params.roundness_check == RoundnessCheck::Predicted
-            && params.roundness_tolerance.is_some()
-            && model.map.roundness_prediction.is_none()
-        {
-            return Err(Error::InvalidParameter {
-                name: "roundness_check",
-                value: model.map.pilot_clones as f64,
-                reason: "Predicted: the pilot clones gave no roundness prediction (too few, or their surface roundness does not predict the measured one); use LevelSet",
-            });
-        }
+        predicted_check_ready(params, &model.map)?;
         Ok(model)
     }
 
