@@ -164,7 +164,38 @@ pub struct MeasureParams {
     pub corner_margin: f64,
     /// How the corner radii are averaged.
     pub averaging: CornerAveraging,
+    /// The grid the roundness is measured on. Default [`RoundnessGrid::Native`] (the
+    /// grain's own grid); [`MeasureParams::voxel_images`] selects
+    /// [`RoundnessGrid::Canonical`] for grains extracted from labelled images.
+    pub roundness_grid: RoundnessGrid,
 }
+
+/// The grid [`Descriptor::Roundness`] is measured on (see the module docs, "Roundness of
+/// voxel images").
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum RoundnessGrid {
+    /// The grain's own grid, whatever its spacing (today's measure; what the cloner, its
+    /// calibration and the mesh/SH parents use, on grids built at `resolution³`).
+    #[default]
+    Native,
+    /// The grain's level set resampled (trilinear) onto the `resolution³` cube of
+    /// ±`margin`·r_max about the centroid of its surface vertices, the frame mesh and SH
+    /// parents and the clones are built in, and reinitialised by fast sweeping. The corner
+    /// rule reads curvatures at the scale of the grid, so a grain measured at another
+    /// relative resolution (a CT scan at 20–60 voxels across) reads other corners: this
+    /// measures every grain at the same relative scale.
+    Canonical {
+        /// Nodes per axis (≥ 8; the cloner's level sets use 45).
+        resolution: usize,
+        /// Half-width of the cube over the largest vertex distance (in (1, 4]; 1.1).
+        margin: f64,
+    },
+}
+
+/// Nodes per axis of [`MeasureParams::voxel_images`]: the cloner's level-set resolution.
+pub const CANONICAL_RESOLUTION: usize = 45;
+/// Margin of [`MeasureParams::voxel_images`] (the cloner's `grid_from_mesh` margin).
+pub const CANONICAL_MARGIN: f64 = 1.1;
 
 /// How [`Descriptor::Roundness`] averages the radii of curvature of corners.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -180,7 +211,21 @@ pub enum CornerAveraging {
 }
 
 impl MeasureParams {
-    /// Checks that the margin is finite and non-negative.
+    /// The parameters for grains extracted from labelled voxel images: the defaults with
+    /// the roundness measured on the canonical grid ([`RoundnessGrid::Canonical`] with
+    /// [`CANONICAL_RESOLUTION`] and [`CANONICAL_MARGIN`]). Every other descriptor is
+    /// measured as with [`MeasureParams::default`], bit for bit.
+    pub fn voxel_images() -> Self {
+        Self {
+            roundness_grid: RoundnessGrid::Canonical {
+                resolution: CANONICAL_RESOLUTION,
+                margin: CANONICAL_MARGIN,
+            },
+            ..Self::default()
+        }
+    }
+
+    /// Checks that the margin is finite and non-negative and the canonical grid valid.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`].
@@ -192,8 +237,41 @@ impl MeasureParams {
                 reason: "finite and >= 0",
             });
         }
+        if let RoundnessGrid::Canonical { resolution, margin } = self.roundness_grid {
+            if !(8..=512).contains(&resolution) {
+                return Err(Error::InvalidParameter {
+                    name: "roundness_grid.resolution",
+                    value: resolution as f64,
+                    reason: "8 ..= 512 nodes per axis",
+                });
+            }
+            if !(margin.is_finite() && margin > 1.0 && margin <= 4.0) {
+                return Err(Error::InvalidParameter {
+                    name: "roundness_grid.margin",
+                    value: margin,
+                    reason: "in (1, 4]",
+                });
+            }
+        }
         Ok(())
     }
+}
+
+/// The grain of `grid` (surface `mesh`) resampled onto the canonical grid of
+/// [`RoundnessGrid::Canonical`]: trilinear values at the new nodes (continued outside the
+/// grid box), then fast-sweeping reinitialisation.
+fn canonical_grid(
+    grid: &Grid,
+    mesh: &levelset::TriMesh,
+    resolution: usize,
+    margin: f64,
+) -> Result<Grid> {
+    let centre = mesh.centroid().map_err(ls_err)?;
+    let spec =
+        GridSpec::around_points(mesh.vertices(), centre, resolution, margin).map_err(ls_err)?;
+    let mut out = Grid::from_fn(spec, |p| grid.value(p)).map_err(ls_err)?;
+    out.reinitialise().map_err(ls_err)?;
+    Ok(out)
 }
 
 /// Hessian of φ at node (i, j, k) by second central differences (one-sided
@@ -641,7 +719,16 @@ impl<'g> Measurement<'g> {
                         let Some(surface) = &self.surface else {
                             unreachable_state()?
                         };
-                        let r = roundness(&self.grid, surface.mesh(), &self.params)?;
+                        let r = match self.params.roundness_grid {
+                            RoundnessGrid::Native => {
+                                roundness(&self.grid, surface.mesh(), &self.params)?
+                            }
+                            RoundnessGrid::Canonical { resolution, margin } => {
+                                let g =
+                                    canonical_grid(&self.grid, surface.mesh(), resolution, margin)?;
+                                roundness(&g, &g.marching_cubes(), &self.params)?
+                            }
+                        };
                         self.roundness = Some(r);
                         r
                     }

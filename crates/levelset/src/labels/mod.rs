@@ -85,8 +85,8 @@
 mod extract;
 
 pub use extract::{
-    ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, MAX_SMOOTHING, SkipCounts,
-    SkipReason, Skipped,
+    ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, MAX_SMOOTHING, ROUNDNESS_SMOOTHING,
+    SkipCounts, SkipReason, Skipped,
 };
 
 use nalgebra::{Point3, Vector3};
