@@ -375,7 +375,7 @@ fn user_dna(args: &Dna, root: &Path, source: &Path) -> anyhow::Result<()> {
     let loaded = crate::parents::load(&args.source, source)?;
     let summary = loaded.summary(source);
     let t = std::time::Instant::now();
-    let params = crate::parents::measure_params(loaded.format);
+    let params = loaded.measure;
     let pb = crate::progress::bar("measuring DNA", loaded.grids.len() as u64, args.quiet);
     let values: Vec<Vec<f64>> = loaded
         .grids

@@ -112,6 +112,11 @@ pub(crate) struct ParentArgs {
     /// the library's default; 0 = exact EDT of the binary crop).
     #[arg(long)]
     pub(crate) smoothing: Option<f64>,
+    /// Measure the roundness of labelled-image grains on their own grid, at the
+    /// scan's resolution (before issue 31), instead of the canonical grid the clones
+    /// and the mesh/SH parents are measured on.
+    #[arg(long)]
+    pub(crate) native_roundness: bool,
     /// Spherical-harmonic degree of `anm` files (default: each file's own).
     #[arg(long)]
     pub(crate) sh_degree: Option<usize>,
@@ -138,6 +143,8 @@ pub(crate) struct Loaded {
     pub(crate) read_s: f64,
     /// Seconds building level sets.
     pub(crate) levelset_s: f64,
+    /// How these grains are measured ([`measure_params`]).
+    pub(crate) measure: morph_dna::MeasureParams,
 }
 
 impl Loaded {
@@ -458,6 +465,7 @@ fn load_image(
         skipped,
         read_s,
         levelset_s,
+        measure: measure_params(format, args.native_roundness),
     };
     check_count(&out, source)?;
     Ok(out)
@@ -516,6 +524,7 @@ fn load_meshes(
         skipped: Vec::new(),
         read_s,
         levelset_s: t1.elapsed().as_secs_f64(),
+        measure: morph_dna::MeasureParams::default(),
     })
 }
 
@@ -551,6 +560,7 @@ fn load_sh(args: &ParentArgs, files: &[PathBuf]) -> anyhow::Result<Loaded> {
         skipped: Vec::new(),
         read_s,
         levelset_s: t1.elapsed().as_secs_f64(),
+        measure: morph_dna::MeasureParams::default(),
     })
 }
 
@@ -574,6 +584,7 @@ fn load_morph(files: &[PathBuf]) -> anyhow::Result<Loaded> {
         skipped: Vec::new(),
         read_s: t0.elapsed().as_secs_f64(),
         levelset_s: 0.0,
+        measure: morph_dna::MeasureParams::default(),
     })
 }
 
@@ -581,9 +592,10 @@ fn load_morph(files: &[PathBuf]) -> anyhow::Result<Loaded> {
 /// on the canonical grid (`morph_dna::MeasureParams::voxel_images`), the same relative
 /// resolution as the mesh, SH and LS-DEM parents built at `--resolution` and as the
 /// clones; every other format keeps the defaults.
-pub(crate) fn measure_params(format: InputFormat) -> morph_dna::MeasureParams {
+/// (`--native-roundness` keeps the scan's own grid).
+pub(crate) fn measure_params(format: InputFormat, native: bool) -> morph_dna::MeasureParams {
     match format {
-        InputFormat::Npy | InputFormat::Tiff | InputFormat::Raw => {
+        InputFormat::Npy | InputFormat::Tiff | InputFormat::Raw if !native => {
             morph_dna::MeasureParams::voxel_images()
         }
         _ => morph_dna::MeasureParams::default(),
@@ -595,14 +607,14 @@ pub(crate) fn measure_params(format: InputFormat) -> morph_dna::MeasureParams {
 pub(crate) fn measure(loaded: Loaded) -> anyhow::Result<(cloner::Parents, Vec<String>, f64)> {
     let t = Instant::now();
     let names = loaded.names;
-    let params = measure_params(loaded.format);
-    let parents = cloner::Parents::from_grids(loaded.grids, &params).map_err(|e| match &e {
-        cloner::Error::DegenerateParent { index, reason } => anyhow::anyhow!(
-            "parent {} cannot be measured: {reason}",
-            names.get(*index).map_or("?", String::as_str)
-        ),
-        _ => anyhow::Error::new(e),
-    })?;
+    let parents =
+        cloner::Parents::from_grids(loaded.grids, &loaded.measure).map_err(|e| match &e {
+            cloner::Error::DegenerateParent { index, reason } => anyhow::anyhow!(
+                "parent {} cannot be measured: {reason}",
+                names.get(*index).map_or("?", String::as_str)
+            ),
+            _ => anyhow::Error::new(e),
+        })?;
     Ok((parents, names, t.elapsed().as_secs_f64()))
 }
 
@@ -633,6 +645,7 @@ mod tests {
             min_voxels: None,
             reject_split: false,
             smoothing: None,
+            native_roundness: false,
             sh_degree: None,
             resolution: 21,
         }

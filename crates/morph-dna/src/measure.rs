@@ -269,9 +269,51 @@ fn canonical_grid(
     let centre = mesh.centroid().map_err(ls_err)?;
     let spec =
         GridSpec::around_points(mesh.vertices(), centre, resolution, margin).map_err(ls_err)?;
-    let mut out = Grid::from_fn(spec, |p| grid.value(p)).map_err(ls_err)?;
-    out.reinitialise().map_err(ls_err)?;
-    Ok(out)
+    Grid::new(spec, resample(grid, &spec)).map_err(ls_err)
+}
+
+/// `grid.value` at every node of `spec` (the same trilinear values and the same
+/// continuation outside the box, up to rounding), with the cell and weight of every node
+/// coordinate found once per axis.
+fn resample(grid: &Grid, spec: &GridSpec) -> Vec<f64> {
+    let src = grid.spec();
+    let axis = |a: usize| -> Vec<(usize, f64, f64)> {
+        let n = src.dims[a];
+        (0..spec.dims[a])
+            .map(|i| {
+                let x = spec.origin[a] + spec.spacing * i as f64;
+                let u = (x - src.origin[a]) / src.spacing;
+                let max = (n - 1) as f64;
+                let uc = u.clamp(0.0, max);
+                // distance outside the box along this axis
+                let out = (u - uc).abs() * src.spacing;
+                let c = (uc as usize).min(n - 2);
+                (c, uc - c as f64, out)
+            })
+            .collect()
+    };
+    let (ax, ay, az) = (axis(0), axis(1), axis(2));
+    let [nx, ny, _] = src.dims;
+    let (sy, sz) = (nx, nx * ny);
+    let v = grid.values();
+    let mut out = Vec::with_capacity(spec.len());
+    for &(k, tz, oz) in &az {
+        for &(j, ty, oy) in &ay {
+            for &(i, tx, ox) in &ax {
+                let b = i + sy * j + sz * k;
+                let c00 = v[b] + tx * (v[b + 1] - v[b]);
+                let c10 = v[b + sy] + tx * (v[b + sy + 1] - v[b + sy]);
+                let c01 = v[b + sz] + tx * (v[b + sz + 1] - v[b + sz]);
+                let c11 = v[b + sy + sz] + tx * (v[b + sy + sz + 1] - v[b + sy + sz]);
+                let c0 = c00 + ty * (c10 - c00);
+                let c1 = c01 + ty * (c11 - c01);
+                let inside = c0 + tz * (c1 - c0);
+                let d2 = ox * ox + oy * oy + oz * oz;
+                out.push(if d2 > 0.0 { inside + d2.sqrt() } else { inside });
+            }
+        }
+    }
+    out
 }
 
 /// Hessian of φ at node (i, j, k) by second central differences (one-sided

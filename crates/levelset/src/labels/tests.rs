@@ -565,6 +565,10 @@ fn voxel_images_params() {
             ..p
         })
         .expect("extract");
-    assert!(ex.grains.iter().all(|g| g.grid.values().iter().all(|v| v.is_finite())));
+    assert!(
+        ex.grains
+            .iter()
+            .all(|g| g.grid.values().iter().all(|v| v.is_finite()))
+    );
     assert!(ex.grains.len() + ex.skipped.len() == ex.labels_found);
 }

@@ -455,7 +455,10 @@ fn canonical_roundness_of_rounded_cubes() {
         assert_eq!(x.to_bits(), y.to_bits());
     }
     // the default measure is untouched by the new field
-    assert_eq!(MeasureParams::default().roundness_grid, RoundnessGrid::Native);
+    assert_eq!(
+        MeasureParams::default().roundness_grid,
+        RoundnessGrid::Native
+    );
 }
 
 /// Invalid canonical grids are refused with a structured error; a grain of a few
@@ -487,8 +490,34 @@ fn canonical_roundness_extremes() {
         }
     }
     let tiny = Grid::from_voxels(spec, &mask).expect("voxels");
-    match measure(&tiny, &[Descriptor::Roundness], &MeasureParams::voxel_images()) {
+    match measure(
+        &tiny,
+        &[Descriptor::Roundness],
+        &MeasureParams::voxel_images(),
+    ) {
         Ok(v) => assert!(v[0].is_finite() && v[0] > 0.0 && v[0] <= 1.0, "{v:?}"),
         Err(e) => println!("tiny grain: {e}"),
+    }
+}
+
+/// The canonical resampling equals `Grid::value` at every node, inside the source box
+/// and beyond it.
+#[test]
+fn resample_matches_grid_value() {
+    let g = ellipsoid_grid(&Isometry3::identity());
+    let spec = GridSpec {
+        dims: [17, 13, 11],
+        origin: Point3::new(-4.1, -2.3, -3.9),
+        spacing: 0.53,
+    };
+    let values = resample(&g, &spec);
+    let [nx, ny, _] = spec.dims;
+    for (n, v) in values.iter().enumerate() {
+        let p = spec.node(n % nx, (n / nx) % ny, n / (nx * ny));
+        assert!(
+            (v - g.value(&p)).abs() < 1e-12,
+            "{p}: {v} vs {}",
+            g.value(&p)
+        );
     }
 }
