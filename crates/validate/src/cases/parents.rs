@@ -349,6 +349,9 @@ fn measure_dna(grids: &[&levelset::Grid], params: &MeasureParams) -> Result<Vec<
         .collect()
 }
 
+/// A round trip's checks, the clones' own DNA rows and the re-read ones (same order).
+type RoundTrip = (Vec<Check>, Vec<Vec<f64>>, Vec<Vec<f64>>);
+
 /// Round trip through a labelled image written and read by `write`/`read`, at
 /// `voxels_per_diameter` voxels across the median clone, extracted and measured as the
 /// image path does ([`levelset::ExtractParams::voxel_images`],
@@ -357,7 +360,7 @@ fn roundtrip_image(
     voxels_per_diameter: f64,
     write: impl Fn(&levelset::LabelImage) -> Result<Vec<u8>, levelset::Error>,
     read: impl Fn(&[u8], f64) -> Result<levelset::LabelImage, levelset::Error>,
-) -> Result<(Vec<Check>, Vec<Vec<f64>>, Vec<Vec<f64>>), Error> {
+) -> Result<RoundTrip, Error> {
     let (grids, own) = roundtrip_clones()?;
     let d: Vec<f64> = own.iter().map(|r| r[1]).collect();
     let h = median(&d) / voxels_per_diameter;
@@ -547,9 +550,7 @@ fn dna_checks(checks: &mut Vec<Check>, own: &[Vec<f64>], reread: &[Vec<f64>], hd
     }
 }
 
-fn roundtrip_npy_at(
-    voxels_per_diameter: f64,
-) -> Result<(Vec<Check>, Vec<Vec<f64>>, Vec<Vec<f64>>), Error> {
+fn roundtrip_npy_at(voxels_per_diameter: f64) -> Result<RoundTrip, Error> {
     roundtrip_image(
         voxels_per_diameter,
         |img| {
