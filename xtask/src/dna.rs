@@ -375,13 +375,14 @@ fn user_dna(args: &Dna, root: &Path, source: &Path) -> anyhow::Result<()> {
     let loaded = crate::parents::load(&args.source, source)?;
     let summary = loaded.summary(source);
     let t = std::time::Instant::now();
+    let params = loaded.measure;
     let pb = crate::progress::bar("measuring DNA", loaded.grids.len() as u64, args.quiet);
     let values: Vec<Vec<f64>> = loaded
         .grids
         .par_iter()
         .zip(&loaded.names)
         .map(|(g, name)| {
-            let v = morph_dna::measure(g, &Descriptor::ALL, &MeasureParams::default())
+            let v = morph_dna::measure(g, &Descriptor::ALL, &params)
                 .with_context(|| format!("measuring {name}"));
             pb.inc(1);
             v

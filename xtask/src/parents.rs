@@ -108,9 +108,15 @@ pub(crate) struct ParentArgs {
     #[arg(long)]
     pub(crate) reject_split: bool,
     /// Gaussian smoothing σ (voxels) of each label before its level set
-    /// (default: the library's; 0 = exact EDT of the binary crop).
+    /// (default: the image path's, `levelset::ROUNDNESS_SMOOTHING` = 0.7; 1 =
+    /// the library's default; 0 = exact EDT of the binary crop).
     #[arg(long)]
     pub(crate) smoothing: Option<f64>,
+    /// Measure the roundness of labelled-image grains on their own grid, at the
+    /// scan's resolution (before issue 31), instead of the canonical grid the clones
+    /// and the mesh/SH parents are measured on.
+    #[arg(long)]
+    pub(crate) native_roundness: bool,
     /// Spherical-harmonic degree of `anm` files (default: each file's own).
     #[arg(long)]
     pub(crate) sh_degree: Option<usize>,
@@ -137,6 +143,8 @@ pub(crate) struct Loaded {
     pub(crate) read_s: f64,
     /// Seconds building level sets.
     pub(crate) levelset_s: f64,
+    /// How these grains are measured ([`measure_params`]).
+    pub(crate) measure: morph_dna::MeasureParams,
 }
 
 impl Loaded {
@@ -397,7 +405,7 @@ fn load_image(
     let t1 = Instant::now();
     let mut params = levelset::ExtractParams {
         exclude_border: !args.keep_border,
-        ..levelset::ExtractParams::default()
+        ..levelset::ExtractParams::voxel_images()
     };
     if let Some(m) = args.min_voxels {
         params.min_voxels = m;
@@ -457,6 +465,7 @@ fn load_image(
         skipped,
         read_s,
         levelset_s,
+        measure: measure_params(format, args.native_roundness),
     };
     check_count(&out, source)?;
     Ok(out)
@@ -515,6 +524,7 @@ fn load_meshes(
         skipped: Vec::new(),
         read_s,
         levelset_s: t1.elapsed().as_secs_f64(),
+        measure: morph_dna::MeasureParams::default(),
     })
 }
 
@@ -550,6 +560,7 @@ fn load_sh(args: &ParentArgs, files: &[PathBuf]) -> anyhow::Result<Loaded> {
         skipped: Vec::new(),
         read_s,
         levelset_s: t1.elapsed().as_secs_f64(),
+        measure: morph_dna::MeasureParams::default(),
     })
 }
 
@@ -573,7 +584,22 @@ fn load_morph(files: &[PathBuf]) -> anyhow::Result<Loaded> {
         skipped: Vec::new(),
         read_s: t0.elapsed().as_secs_f64(),
         levelset_s: 0.0,
+        measure: morph_dna::MeasureParams::default(),
     })
+}
+
+/// The measurement of grains read in `format`: labelled images measure their roundness
+/// on the canonical grid (`morph_dna::MeasureParams::voxel_images`), the same relative
+/// resolution as the mesh, SH and LS-DEM parents built at `--resolution` and as the
+/// clones; every other format keeps the defaults.
+/// (`--native-roundness` keeps the scan's own grid).
+pub(crate) fn measure_params(format: InputFormat, native: bool) -> morph_dna::MeasureParams {
+    match format {
+        InputFormat::Npy | InputFormat::Tiff | InputFormat::Raw if !native => {
+            morph_dna::MeasureParams::voxel_images()
+        }
+        _ => morph_dna::MeasureParams::default(),
+    }
 }
 
 /// Measures the loaded grains as cloner parents, naming the grain of any
@@ -581,14 +607,14 @@ fn load_morph(files: &[PathBuf]) -> anyhow::Result<Loaded> {
 pub(crate) fn measure(loaded: Loaded) -> anyhow::Result<(cloner::Parents, Vec<String>, f64)> {
     let t = Instant::now();
     let names = loaded.names;
-    let parents = cloner::Parents::from_grids(loaded.grids, &morph_dna::MeasureParams::default())
-        .map_err(|e| match &e {
-        cloner::Error::DegenerateParent { index, reason } => anyhow::anyhow!(
-            "parent {} cannot be measured: {reason}",
-            names.get(*index).map_or("?", String::as_str)
-        ),
-        _ => anyhow::Error::new(e),
-    })?;
+    let parents =
+        cloner::Parents::from_grids(loaded.grids, &loaded.measure).map_err(|e| match &e {
+            cloner::Error::DegenerateParent { index, reason } => anyhow::anyhow!(
+                "parent {} cannot be measured: {reason}",
+                names.get(*index).map_or("?", String::as_str)
+            ),
+            _ => anyhow::Error::new(e),
+        })?;
     Ok((parents, names, t.elapsed().as_secs_f64()))
 }
 
@@ -619,6 +645,7 @@ mod tests {
             min_voxels: None,
             reject_split: false,
             smoothing: None,
+            native_roundness: false,
             sh_degree: None,
             resolution: 21,
         }

@@ -111,8 +111,9 @@ pub use grading::{GradingCoefficients, GradingCurve, GradingInterpolation, Gradi
 pub use histogram::{BinAxis, Histogram1d, Histogram2d};
 pub use hull::{convex_hull, convex_hull_volume};
 pub use measure::{
-    CornerAveraging, MeasureParams, Measurement, PrincipalFrame, max_principal_curvature, measure,
-    measure_star, measure_table, measure_with_frame, principal_frame, radial_profile,
+    CANONICAL_MARGIN, CANONICAL_RESOLUTION, CornerAveraging, MeasureParams, Measurement,
+    PrincipalFrame, RoundnessGrid, max_principal_curvature, measure, measure_star, measure_table,
+    measure_with_frame, principal_frame, radial_profile,
 };
 pub use pdf::{Bandwidth, BicubicPdf, GaussianKde2d, TabulatedPdf2d};
 pub use radial::{

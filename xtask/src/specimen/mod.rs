@@ -300,6 +300,7 @@ fn load_parents(scene: &Scene, root: &Path) -> anyhow::Result<(Option<cloner::Pa
         min_voxels: *min_voxels,
         reject_split: false,
         smoothing: *smoothing,
+        native_roundness: false,
         sh_degree: *sh_degree,
         resolution: *resolution,
     };

@@ -56,6 +56,24 @@ impl Default for ExtractParams {
     }
 }
 
+/// Gaussian σ (voxels) of [`ExtractParams::voxel_images`]: the blur under which the
+/// roundness measured on the canonical grid (morph-dna's `MeasureParams::voxel_images`)
+/// is unbiased on voxelised clones (see the module doc of [`crate::labels`]).
+pub const ROUNDNESS_SMOOTHING: f64 = 0.7;
+
+impl ExtractParams {
+    /// The defaults with [`ROUNDNESS_SMOOTHING`] (σ = 0.7 instead of 1): the extraction of
+    /// the image path (`cargo xtask dna / calibrate --parents IMAGE`), whose roundness is
+    /// measured on the canonical grid. `Self::default()` (σ = 1) and `smoothing: None`
+    /// (exact EDT) stay selectable.
+    pub fn voxel_images() -> Self {
+        Self {
+            smoothing: Some(ROUNDNESS_SMOOTHING),
+            ..Self::default()
+        }
+    }
+}
+
 /// Largest Gaussian σ accepted, in voxels (a wider blur erases grains of a few voxels and
 /// costs a kernel of 6σ + 1 taps per axis).
 pub const MAX_SMOOTHING: f64 = 8.0;

@@ -14,6 +14,7 @@ mod rounding;
 pub mod specimen;
 mod specimen_dem;
 mod sph_harmonics;
+mod voxel_roundness;
 
 /// Every registered case, in a stable order.
 #[must_use]
@@ -29,6 +30,7 @@ pub fn registry() -> Vec<Case> {
     cases.extend(specimen::cases());
     cases.extend(specimen_dem::cases());
     cases.extend(sph_harmonics::cases());
+    cases.extend(voxel_roundness::cases());
     cases
 }
 
@@ -46,5 +48,6 @@ pub fn expected_failures() -> Vec<ExpectedFailure> {
     list.extend_from_slice(specimen::EXPECTED_FAILURES);
     list.extend_from_slice(specimen_dem::EXPECTED_FAILURES);
     list.extend_from_slice(sph_harmonics::EXPECTED_FAILURES);
+    list.extend_from_slice(voxel_roundness::EXPECTED_FAILURES);
     list
 }

@@ -55,6 +55,13 @@ pub(crate) fn cases() -> Vec<Case> {
             run: roundtrip_npy,
         },
         Case {
+            name: "parents/roundtrip-npy-20",
+            description: "the round trip through .npy at 20 voxels across the median clone: every grain back, DNA within the h/D tolerances, roundness within 10 % of the clones' own on average",
+            fast: false,
+            heavy: false,
+            run: roundtrip_npy_20,
+        },
+        Case {
             name: "parents/roundtrip-tiff",
             description: "the same clones through a multi-page TIFF stack: image identical, every grain back, DNA within the h/D tolerances",
             fast: false,
@@ -71,11 +78,36 @@ pub(crate) fn cases() -> Vec<Case> {
     ]
 }
 
-pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[ExpectedFailure {
-    case: "parents/ottawa-representative",
-    metric: "median inertia elongation I/L vs population W/L (reported)",
-    reason: "not like with like (our finding): I/L of the inertia-equivalent ellipsoid is not NIST's caliper W/L; on the same 71 grains it is 0.770 against NIST's 0.825, while our caliper I/L (0.816) agrees with NIST's own W/L to -0.004 and with the population to 0.012; the like-with-like checks above are the acceptance",
-}];
+/// Why the voxel roundness misses issue 31's targets at 30 voxels per diameter (our finding).
+const VOXEL_ROUNDNESS_REASON: &str = "issue 31, not met (our finding): the clones' own roundness is the corner rule read at their 45³ grid's scale, and even their exact surface re-gridded onto another 45³ cube (the canonical grid) reproduces it only to 2.6 % mean / 8.1 % worst, Spearman 0.947, slope 0.905 (at the voxel spacing: 5.9 % / 31.6 %, Spearman 0.73); a 30-voxel image quantises the corners (radii of 3-6 voxels) to ±h/2, and no reconstruction tried keeps both the corners and no staircase curvature: σ = 0.7 + canonical grid (the image path) 6.1 % / 35 %, Spearman 0.56, slope 0.38, no bias (with the canonical grid reinitialised by fast sweeping 5.6 % / 31 %, 0.59, 0.42, at 6-7 ms more per grain; today's σ = 1 on the crop: 14 % / 68 %, 0.12, 0.03); σ = 1 / 1.5 + canonical +13 % / +24 % bias; constrained (sign-preserving) smoothing Spearman ≤ 0.75 with ±10 % bias; SH fits of degree 16-32 of the voxel surface Spearman ≤ 0.76 with +7-17 % bias; blur with a σ²H/2 curvature de-bias +21 % at σ = 2";
+
+pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
+    ExpectedFailure {
+        case: "parents/ottawa-representative",
+        metric: "median inertia elongation I/L vs population W/L (reported)",
+        reason: "not like with like (our finding): I/L of the inertia-equivalent ellipsoid is not NIST's caliper W/L; on the same 71 grains it is 0.770 against NIST's 0.825, while our caliper I/L (0.816) agrees with NIST's own W/L to -0.004 and with the population to 0.012; the like-with-like checks above are the acceptance",
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "roundness mean |rel. error| <= 5 %",
+        reason: VOXEL_ROUNDNESS_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "roundness worst |rel. error| <= 20 %",
+        reason: VOXEL_ROUNDNESS_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "roundness Spearman rank correlation with the clones' own >= 0.9",
+        reason: VOXEL_ROUNDNESS_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "roundness slope (voxel on own, least squares) 0.9-1.1",
+        reason: VOXEL_ROUNDNESS_REASON,
+    },
+];
 
 fn err(e: impl std::fmt::Display) -> Error {
     Error::Computation {
@@ -310,27 +342,34 @@ fn relative_differences(own: &[Vec<f64>], reread: &[Vec<f64>]) -> Vec<Vec<f64>> 
         .collect()
 }
 
-fn measure_dna(grids: &[&levelset::Grid]) -> Result<Vec<Vec<f64>>, Error> {
+fn measure_dna(grids: &[&levelset::Grid], params: &MeasureParams) -> Result<Vec<Vec<f64>>, Error> {
     grids
         .iter()
-        .map(|g| morph_dna::measure(g, &cloner::DNA, &MeasureParams::default()).map_err(err))
+        .map(|g| morph_dna::measure(g, &cloner::DNA, params).map_err(err))
         .collect()
 }
 
-/// Round trip through a labelled image written and read by `write`/`read`.
+/// A round trip's checks, the clones' own DNA rows and the re-read ones (same order).
+type RoundTrip = (Vec<Check>, Vec<Vec<f64>>, Vec<Vec<f64>>);
+
+/// Round trip through a labelled image written and read by `write`/`read`, at
+/// `voxels_per_diameter` voxels across the median clone, extracted and measured as the
+/// image path does ([`levelset::ExtractParams::voxel_images`],
+/// [`MeasureParams::voxel_images`]).
 fn roundtrip_image(
+    voxels_per_diameter: f64,
     write: impl Fn(&levelset::LabelImage) -> Result<Vec<u8>, levelset::Error>,
     read: impl Fn(&[u8], f64) -> Result<levelset::LabelImage, levelset::Error>,
-) -> Result<Vec<Check>, Error> {
+) -> Result<RoundTrip, Error> {
     let (grids, own) = roundtrip_clones()?;
     let d: Vec<f64> = own.iter().map(|r| r[1]).collect();
-    let h = median(&d) / ROUNDTRIP_VOXELS_PER_DIAMETER;
+    let h = median(&d) / voxels_per_diameter;
     let image = paint_lattice(grids, h, 3)?;
     let bytes = write(&image).map_err(err)?;
     let back = read(&bytes, h).map_err(err)?;
     let same = back.dims == image.dims && back.labels == image.labels;
     let ex = back
-        .extract(&levelset::ExtractParams::default())
+        .extract(&levelset::ExtractParams::voxel_images())
         .map_err(err)?;
     let mut checks = vec![
         Check::new(
@@ -348,10 +387,116 @@ fn roundtrip_image(
     ];
     let by_label: Vec<&levelset::Grid> = ex.grains.iter().map(|g| &g.grid).collect();
     let labels: Vec<usize> = ex.grains.iter().map(|g| g.label as usize - 1).collect();
-    let reread = measure_dna(&by_label)?;
+    let reread = measure_dna(&by_label, &MeasureParams::voxel_images())?;
     let own: Vec<Vec<f64>> = labels.iter().map(|&i| own[i].clone()).collect();
     dna_checks(&mut checks, &own, &reread, h / median(&d), "voxel");
-    Ok(checks)
+    Ok((checks, own, reread))
+}
+
+/// Index of the roundness in [`cloner::DNA`].
+fn roundness_column() -> Result<usize, Error> {
+    cloner::DNA
+        .iter()
+        .position(|d| *d == Descriptor::Roundness)
+        .ok_or_else(|| err("roundness is not a DNA parameter"))
+}
+
+/// Spearman's rank correlation (average ranks for ties).
+#[must_use]
+pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
+    let ranks = |v: &[f64]| {
+        let mut idx: Vec<usize> = (0..v.len()).collect();
+        idx.sort_by(|&i, &j| v[i].total_cmp(&v[j]));
+        let mut r = vec![0.0; v.len()];
+        let mut s = 0;
+        while s < idx.len() {
+            let mut e = s + 1;
+            while e < idx.len() && v[idx[e]] == v[idx[s]] {
+                e += 1;
+            }
+            let avg = 0.5 * (s + e - 1) as f64;
+            for &i in &idx[s..e] {
+                r[i] = avg;
+            }
+            s = e;
+        }
+        r
+    };
+    let (ra, rb) = (ranks(a), ranks(b));
+    let n = ra.len() as f64;
+    let (ma, mb) = (ra.iter().sum::<f64>() / n, rb.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in ra.iter().zip(&rb) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    sab / (saa * sbb).sqrt()
+}
+
+/// Least-squares slope of `y` on `x`.
+#[must_use]
+pub fn ols_slope(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (a, b) in x.iter().zip(y) {
+        sxy += (a - mx) * (b - my);
+        sxx += (a - mx) * (a - mx);
+    }
+    sxy / sxx
+}
+
+/// The issue-31 acceptance of the voxel roundness against the clones' own: mean and worst
+/// relative error, and (`ranking`) Spearman's ρ ≥ 0.9 and a slope of 0.9–1.1 (no pull
+/// toward the population mean).
+fn roundness_checks(
+    checks: &mut Vec<Check>,
+    own: &[Vec<f64>],
+    reread: &[Vec<f64>],
+    (mean_max, worst_max): (f64, f64),
+    ranking: bool,
+) -> Result<(), Error> {
+    let k = roundness_column()?;
+    let x: Vec<f64> = own.iter().map(|r| r[k]).collect();
+    let y: Vec<f64> = reread.iter().map(|r| r[k]).collect();
+    let rel: Vec<f64> = x.iter().zip(&y).map(|(a, b)| ((b - a) / a).abs()).collect();
+    let mean = rel.iter().sum::<f64>() / rel.len().max(1) as f64;
+    let worst = rel.iter().fold(0.0f64, |a, b| a.max(*b));
+    let bias = x.iter().zip(&y).map(|(a, b)| (b - a) / a).sum::<f64>() / x.len().max(1) as f64;
+    checks.push(Check::new(
+        format!("roundness mean |rel. error| <= {:.0} %", 100.0 * mean_max),
+        mean_max,
+        mean,
+        Tolerance::AtMost(0.0),
+    ));
+    checks.push(Check::new(
+        format!("roundness worst |rel. error| <= {:.0} %", 100.0 * worst_max),
+        worst_max,
+        worst,
+        Tolerance::AtMost(0.0),
+    ));
+    checks.push(Check::new(
+        "roundness mean signed rel. error within 5 % (no bias)",
+        0.0,
+        bias,
+        Tolerance::Within(0.05),
+    ));
+    if ranking {
+        checks.push(Check::new(
+            "roundness Spearman rank correlation with the clones' own >= 0.9",
+            0.9,
+            spearman(&x, &y),
+            Tolerance::AtLeast(0.0),
+        ));
+        checks.push(Check::new(
+            "roundness slope (voxel on own, least squares) 0.9-1.1",
+            1.0,
+            ols_slope(&x, &y),
+            Tolerance::Within(0.1),
+        ));
+    }
+    Ok(())
 }
 
 /// The tolerances of the round trips, derived from the resolution `h / D`
@@ -405,8 +550,9 @@ fn dna_checks(checks: &mut Vec<Check>, own: &[Vec<f64>], reread: &[Vec<f64>], hd
     }
 }
 
-fn roundtrip_npy() -> Result<Vec<Check>, Error> {
+fn roundtrip_npy_at(voxels_per_diameter: f64) -> Result<RoundTrip, Error> {
     roundtrip_image(
+        voxels_per_diameter,
         |img| {
             let mut buf = Vec::new();
             levelset::io::write_npy(&mut buf, img, levelset::io::Dtype::U16)?;
@@ -416,15 +562,29 @@ fn roundtrip_npy() -> Result<Vec<Check>, Error> {
     )
 }
 
+fn roundtrip_npy() -> Result<Vec<Check>, Error> {
+    let (mut checks, own, reread) = roundtrip_npy_at(ROUNDTRIP_VOXELS_PER_DIAMETER)?;
+    roundness_checks(&mut checks, &own, &reread, (0.05, 0.20), true)?;
+    Ok(checks)
+}
+
+fn roundtrip_npy_20() -> Result<Vec<Check>, Error> {
+    let (mut checks, own, reread) = roundtrip_npy_at(20.0)?;
+    roundness_checks(&mut checks, &own, &reread, (0.10, 0.40), false)?;
+    Ok(checks)
+}
+
 fn roundtrip_tiff() -> Result<Vec<Check>, Error> {
-    roundtrip_image(
+    Ok(roundtrip_image(
+        ROUNDTRIP_VOXELS_PER_DIAMETER,
         |img| {
             let mut buf = std::io::Cursor::new(Vec::new());
             levelset::io::write_tiff(&mut buf, img)?;
             Ok(buf.into_inner())
         },
         |b, h| levelset::io::read_tiff(std::io::Cursor::new(b), h),
-    )
+    )?
+    .0)
 }
 
 fn roundtrip_stl() -> Result<Vec<Check>, Error> {
@@ -445,7 +605,7 @@ fn roundtrip_stl() -> Result<Vec<Check>, Error> {
     }
     let hd = hd / median(&d);
     let refs: Vec<&levelset::Grid> = reread_grids.iter().collect();
-    let reread = measure_dna(&refs)?;
+    let reread = measure_dna(&refs, &MeasureParams::default())?;
     let mut checks = vec![Check::new(
         "grains read back",
         grids.len() as f64,
