@@ -24,11 +24,11 @@
 
 use std::fs::File;
 use std::hint::black_box;
-use std::io::BufReader;
+use std::io::{BufReader, Write as _};
 use std::path::PathBuf;
 use std::time::Instant;
 
-use cloner::{Calibrated, CloneModel, Clock, Hooks, Parents, clone_rng};
+use cloner::{Calibrated, Clock, CloneModel, Hooks, Parents, clone_rng};
 use criterion::{Criterion, criterion_group, criterion_main};
 use morph_dna::{MeasureParams, measure};
 
@@ -78,7 +78,9 @@ fn composition(model: &CloneModel) {
     let st = &run.stats;
     let per = st.accepted as f64;
     let ms = |ns: u64| ns as f64 * 1e-6 / per;
-    eprintln!(
+    // (a bench's report to the terminal, beside criterion's own)
+    let _ = writeln!(
+        std::io::stderr(),
         "stage composition of {} accepted clones: {:.2} candidates, {:.1} polishing steps, {:.2} predicted-roundness passes, {:.2} level sets per clone; CPU ms per clone: targets {:.3}, radii {:.3}, polishing {:.3}, quality control {:.3}, rasterisation {:.3}, DNA {:.3}",
         st.accepted,
         st.attempts as f64 / per,
@@ -138,7 +140,9 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("5 roundness prediction", |b| {
         b.iter(|| {
-            let ins = geom.inscribed_radius(black_box(&clone.radii)).expect("r_ins");
+            let ins = geom
+                .inscribed_radius(black_box(&clone.radii))
+                .expect("r_ins");
             black_box(geom.roundness_about(&clone.radii, res, margin, ins))
         })
     });
@@ -148,8 +152,12 @@ fn bench(c: &mut Criterion) {
     let grid = model.rasterise(&clone.radii).expect("grid");
     g.bench_function("7 DNA", |b| {
         b.iter(|| {
-            black_box(measure(black_box(&grid), &cloner::DNA, &MeasureParams::default()))
-                .expect("dna")
+            black_box(measure(
+                black_box(&grid),
+                &cloner::DNA,
+                &MeasureParams::default(),
+            ))
+            .expect("dna")
         })
     });
     g.finish();

@@ -687,7 +687,8 @@ impl CloneModel {
             })
             .collect();
         let pairs = samples.into_iter().collect::<Result<Vec<_>>>()?;
-        let (prediction, prediction_sd) = fit_roundness_prediction(&pairs, self.params.roundness_check);
+        let (prediction, prediction_sd) =
+            fit_roundness_prediction(&pairs, self.params.roundness_check);
         let mut map = SteeringMap::identity(parent_mean);
         map.pilot_clones = pairs.len();
         map.roundness_prediction = prediction;

@@ -686,7 +686,11 @@ fn the_predicted_roundness_check_builds_no_level_set() {
         let r = geom.roundness_about(&c.radii, res, margin, ins);
         let predicted = pred[0] + pred[1] * r + pred[2] * ins / c.surface.r_min;
         let miss = predicted - map.pulled(3, c.targets.roundness);
-        assert!(miss.abs() <= tol, "clone {}: predicted miss {miss}", c.index);
+        assert!(
+            miss.abs() <= tol,
+            "clone {}: predicted miss {miss}",
+            c.index
+        );
     }
     // the DNA afterwards is the DNA output of the same clones
     let with_dna = CloneModel::fit(
