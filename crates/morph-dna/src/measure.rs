@@ -49,8 +49,9 @@
 //!   source is a signed distance already; reinitialising costs 6–7 ms per grain and moved
 //!   the round trip's mean error by 0.5 %). What the canonical grid cannot undo is the
 //!   voxel staircase: with levelset's `ExtractParams::voxel_images` (σ = 0.7) the 40-clone
-//!   round trip at 30 voxels per diameter reads 6.1 % mean, 35 % worst, no bias (σ = 1 on
-//!   the crop, before: 14 %, 68 %, +7.6 %), but ranks the clones weakly (Spearman 0.56)
+//!   round trip at 30 voxels per diameter reads 7.0 % mean, 38.6 % worst, +0.6 % bias
+//!   (σ = 1 on the crop, before: 14 %, 68 %, +7.6 %), but ranks the clones weakly
+//!   (Spearman 0.53)
 //!   and voxelised analytic grains all read 0.35–0.48; see the validate cases
 //!   `parents/roundtrip-npy` and `levelset/voxel-roundness` for the measurements.
 //! * **Principal frame signs** (eigenvectors are defined up to sign): the

@@ -96,11 +96,16 @@ pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
         metric: "20 spheres: clump roundness mean |error| %",
         reason: ROUNDNESS,
     },
+    ExpectedFailure {
+        case: "specimen/clump-shape",
+        metric: "50 spheres: clump roundness mean |error| %",
+        reason: ROUNDNESS,
+    },
 ];
 
 const TRIM_10: &str = "A 10-sphere clump of a packed grain loses more to the trimming against its neighbours and the walls (its spheres are larger and reach farther past the grain's surface, across the 1 % packing margin): measured 1.9 % mean (within the 3 % bound) but 9.6 % worst volume, 5.3 % inertia, 0.017 d centroid offset on 200 packed Ottawa clones. Use 20 or more spheres for a specimen (20: 0.7 % / 3.9 %; 50: 0.1 % / 1.0 %).";
 
-const ROUNDNESS: &str = "3D roundness (mean corner curvature radius over the inscribed radius) of a sphere union is set by its spheres, not by the grain's corners: the union is bumpy at the scale of its spheres (convex bumps and concave crevices), so the measured roundness differs from the level set's by 33 / 15 / 9.9 % at 10 / 20 / 50 spheres (200 packed Ottawa clones; 50 spheres just within the 10 % bound). Volume, V/S and aspect ratio of the delivered clumps are within 5 % at 20 and 50 spheres; roundness needs more spheres than a DEM run can afford, or a level-set DEM (LS-DEM output).";
+const ROUNDNESS: &str = "3D roundness (mean corner curvature radius over the inscribed radius) of a sphere union is set by its spheres, not by the grain's corners: the union is bumpy at the scale of its spheres (convex bumps and concave crevices), so the measured roundness differs from the level set's by 34.5 / 16.2 / 10.1 % at 10 / 20 / 50 spheres (200 packed Ottawa clones of the issue-30 calibration; the previous calibration's clones gave 33 / 15 / 9.9 %, 50 spheres then just within the 10 % bound). Volume, V/S and aspect ratio of the delivered clumps are within 5 % at 20 and 50 spheres; roundness needs more spheres than a DEM run can afford, or a level-set DEM (LS-DEM output).";
 
 /// Level-set nodes per axis of the grains.
 const RESOLUTION: usize = 45;
