@@ -772,7 +772,8 @@ impl CloneModel {
     /// `cand` before any level set while the roundness predicted from its
     /// surface DNA and inscribed radius misses its target by more than the
     /// margin (a fraction of the tolerance `t`). Returns the predicted miss
-    /// of the candidate as it leaves (`None` if it cannot be predicted).
+    /// of the candidate as it leaves (`None` if it cannot be predicted, and
+    /// after the last pass of the level-set check, which measures instead).
     fn predicted_roundness_passes(
         &self,
         cand: &mut Candidate,
@@ -783,8 +784,9 @@ impl CloneModel {
         clock: &dyn Clock,
     ) -> Option<f64> {
         let margin = self.params.roundness_prediction_margin * t;
+        let passes = self.params.roundness_predictions;
         let mut miss = self.predicted_miss(cand, pred, stats, clock)?;
-        for _ in 0..self.params.roundness_predictions {
+        for pass in 1..=passes {
             if miss.abs() <= margin {
                 break;
             }
@@ -794,6 +796,10 @@ impl CloneModel {
             match self.resteer(cand, miss / pred[1], s, stats, clock) {
                 Ok(c) => *cand = c,
                 Err(_) => break,
+            }
+            // the level-set check measures after the last pass: no prediction
+            if pass == passes && self.params.roundness_check == RoundnessCheck::LevelSet {
+                return None;
             }
             miss = self.predicted_miss(cand, pred, stats, clock)?;
         }

@@ -4,6 +4,7 @@
 //! spheres of different grains (see the parent module, step 3).
 
 use nalgebra::{Matrix3, Point3, UnitQuaternion, Vector3};
+use packer_spheres::FireControl;
 use rayon::prelude::*;
 
 use super::StarGrain;
@@ -517,16 +518,7 @@ impl System<'_> {
     /// FIRE until the largest overlap is at most the tolerance (`true`) or
     /// `max_iter` iterations (`false`).
     fn relax(&mut self, max_iter: usize, stats: &mut CompactStats) -> bool {
-        const N_MIN: usize = 5;
-        const F_INC: f64 = 1.1;
-        const F_DEC: f64 = 0.5;
-        const ALPHA0: f64 = 0.1;
-        const F_ALPHA: f64 = 0.99;
-        const DT0: f64 = 0.05;
-        const DT_MAX: f64 = 0.25;
-        let mut dt = DT0;
-        let mut alpha = ALPHA0;
-        let mut npos = 0usize;
+        let mut fire = FireControl::new(0.05, 0.25);
         let mut checkpoint = f64::INFINITY;
         self.u.iter_mut().for_each(|u| *u = [0.0; 6]);
         let lim = 0.25 * self.skin * self.skin;
@@ -561,24 +553,7 @@ impl System<'_> {
             }
             stats.iterations += 1;
             let (g, s) = self.body_forces();
-            let mix = if s.power > 0.0 {
-                npos += 1;
-                if npos > N_MIN {
-                    dt = (dt * F_INC).min(DT_MAX);
-                    alpha *= F_ALPHA;
-                }
-                Some(if s.ff > 0.0 {
-                    alpha * (s.uu / s.ff).sqrt()
-                } else {
-                    0.0
-                })
-            } else {
-                npos = 0;
-                dt *= F_DEC;
-                alpha = ALPHA0;
-                None
-            };
-            let a = alpha;
+            let (mix, a, dt) = fire.update(s.power, s.uu, s.ff);
             (
                 self.u.par_iter_mut(),
                 self.c.par_iter_mut(),

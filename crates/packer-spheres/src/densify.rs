@@ -68,8 +68,11 @@ use super::{Container, Pack3Params, Sphere};
 use crate::error::{Error, Result, finite, positive};
 use packer_quadtree::Grading;
 
+mod fire;
 mod geom;
 mod system;
+
+pub use fire::FireControl;
 
 use geom::Geom;
 use system::{INDEX_MASK, System};

@@ -101,8 +101,8 @@ mod slabs;
 
 pub use container::{Container, MeshContainer};
 pub use densify::{
-    Boundary, DensePacking3, Densified, DensifyParams, DensifyStats, Target, densify, max_overlap,
-    pack3d_dense,
+    Boundary, DensePacking3, Densified, DensifyParams, DensifyStats, FireControl, Target, densify,
+    max_overlap, pack3d_dense,
 };
 pub use io::{
     LammpsData3, read_csv3, read_lammps_data3, read_vtu3, read_yade3, write_csv3,

@@ -4,8 +4,8 @@
 
 use rayon::prelude::*;
 
-use super::DensifyStats;
 use super::geom::Geom;
+use super::{DensifyStats, FireControl};
 use crate::Sphere;
 
 /// Spheres per chunk of the deterministic global sums.
@@ -381,16 +381,7 @@ impl System {
     /// FIRE until the largest overlap is at most the tolerance; `false`
     /// when `max_iter` iterations did not get there.
     pub(super) fn relax(&mut self, max_iter: usize, stats: &mut DensifyStats) -> bool {
-        const N_MIN: usize = 5;
-        const F_INC: f64 = 1.1;
-        const F_DEC: f64 = 0.5;
-        const ALPHA0: f64 = 0.1;
-        const F_ALPHA: f64 = 0.99;
-        const DT0: f64 = 0.1;
-        const DT_MAX: f64 = 0.5;
-        let mut dt = DT0;
-        let mut alpha = ALPHA0;
-        let mut npos = 0usize;
+        let mut fire = FireControl::new(0.1, 0.5);
         for v in &mut self.v {
             *v = [0.0; 3];
         }
@@ -409,24 +400,7 @@ impl System {
                 break;
             }
             stats.iterations += 1;
-            let mix = if s.power > 0.0 {
-                npos += 1;
-                if npos > N_MIN {
-                    dt = (dt * F_INC).min(DT_MAX);
-                    alpha *= F_ALPHA;
-                }
-                Some(if s.ff > 0.0 {
-                    alpha * (s.vv / s.ff).sqrt()
-                } else {
-                    0.0
-                })
-            } else {
-                npos = 0;
-                dt *= F_DEC;
-                alpha = ALPHA0;
-                None
-            };
-            let a = alpha;
+            let (mix, a, dt) = fire.update(s.power, s.vv, s.ff);
             let periods = self.geom.periods();
             // velocity mixing, semi-implicit Euler, and whether a centre left half the skin
             stale = self

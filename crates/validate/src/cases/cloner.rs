@@ -40,9 +40,18 @@ pub(crate) fn rerun_calibration(
     parents: &cloner::Parents,
 ) -> Result<(Calibrated, cloner::Scores, usize, u64), Error> {
     let cal = Calibrated::from_ron(fixtures::calibrated(name)?).map_err(err)?;
-    let model = CloneModel::fit(parents, &cal.params).map_err(err)?;
+    // as `cargo xtask calibrate` does: cloned without outputs, then scored
+    // on the clones' level sets (the DNA output, bit for bit)
+    let params = cloner::Params {
+        outputs: cloner::Outputs {
+            level_set: false,
+            dna: false,
+        },
+        ..cal.params
+    };
+    let model = CloneModel::fit(parents, &params).map_err(err)?;
     let run = model.run(0..cal.clones, Hooks::default()).map_err(err)?;
-    let s = score(parents.dna(), &run.dna_table().map_err(err)?).map_err(err)?;
+    let s = score(parents.dna(), &model.measure_dna(&run.clones).map_err(err)?).map_err(err)?;
     Ok((cal, s, run.clones.len(), run.stats.attempts))
 }
 
