@@ -313,6 +313,19 @@ struct System<'a> {
     built: bool,
     /// Torques applied (off: translations only).
     rotations: bool,
+    /// External force of each body along −z (its weight in a settling;
+    /// zero in a compaction), applied at its centre.
+    weight: Vec<f64>,
+}
+
+/// When a relaxation is done.
+#[derive(Debug, Clone, Copy)]
+enum Until {
+    /// No overlap deeper than the tolerance (the compaction).
+    Separated,
+    /// Every body at rest: its net generalised force `(F, τ/k)` at most
+    /// this (a settling under the weights).
+    AtRest(f64),
 }
 
 impl System<'_> {
@@ -483,6 +496,7 @@ impl System<'_> {
                     fo += fs;
                     to += arm.cross(&fs);
                 }
+                fo.z -= self.weight[b];
                 let t = if self.rotations {
                     to / k[b]
                 } else {
@@ -517,7 +531,7 @@ impl System<'_> {
 
     /// FIRE until the largest overlap is at most the tolerance (`true`) or
     /// `max_iter` iterations (`false`).
-    fn relax(&mut self, max_iter: usize, stats: &mut CompactStats) -> bool {
+    fn relax(&mut self, max_iter: usize, stats: &mut CompactStats, until: Until) -> bool {
         let mut fire = FireControl::new(0.05, 0.25);
         let mut checkpoint = f64::INFINITY;
         self.u.iter_mut().for_each(|u| *u = [0.0; 6]);
@@ -537,22 +551,35 @@ impl System<'_> {
                 stats.neighbour_builds += 1;
             }
             let worst = self.sphere_forces();
-            if worst <= self.tol {
+            if matches!(until, Until::Separated) && worst <= self.tol {
                 return true;
+            }
+            let (g, s) = self.body_forces();
+            if let Until::AtRest(ftol) = until {
+                let rest = g
+                    .par_chunks(CHUNK)
+                    .map(|gs| {
+                        gs.iter()
+                            .map(|gi| gi.iter().map(|v| v * v).sum::<f64>())
+                            .fold(0.0, f64::max)
+                    })
+                    .reduce(|| 0.0, f64::max);
+                if rest <= ftol * ftol {
+                    return true;
+                }
             }
             if it == max_iter {
                 break;
             }
             // A jammed step: the deepest overlap has not shrunk by a tenth
             // over the last STALL iterations (checked from 2·STALL on).
-            if it % STALL == 0 {
+            if matches!(until, Until::Separated) && it % STALL == 0 {
                 if it >= 2 * STALL && worst > 0.9 * checkpoint {
                     break;
                 }
                 checkpoint = worst;
             }
             stats.iterations += 1;
-            let (g, s) = self.body_forces();
             let (mix, a, dt) = fire.update(s.power, s.uu, s.ff);
             (
                 self.u.par_iter_mut(),
@@ -589,22 +616,16 @@ impl System<'_> {
     }
 }
 
-/// Grows the grains' proxies from scale `lam0` to 1 inside `region`,
-/// moving `centres` and `quats` (FIRE on rigid clumps: see the parent
-/// module).
-///
-/// # Errors
-/// [`Error::NotConverged`] when a growth step of 1e-3 does not relax
-/// (naming the scale reached).
-pub(super) fn compact(
+/// The FIRE system of `grains`' proxies at `centres` / `quats`, scale `lam`.
+fn system<'a>(
     grains: &[StarGrain],
-    proxy: &Proxy,
-    region: &Region<'_>,
-    centres: &mut [Vector3<f64>],
-    quats: &mut [UnitQuaternion<f64>],
-    lam0: f64,
+    proxy: &'a Proxy,
+    region: &'a Region<'a>,
+    centres: &[Vector3<f64>],
+    quats: &[UnitQuaternion<f64>],
+    lam: f64,
     params: &CompactParams,
-) -> Result<CompactStats> {
+) -> Result<System<'a>> {
     let n = grains.len();
     let d_eq: Vec<f64> = grains.iter().map(StarGrain::equivalent_diameter).collect();
     let d_min = d_eq.iter().copied().fold(f64::INFINITY, f64::min);
@@ -627,7 +648,7 @@ pub(super) fn compact(
         let v = region.shift((code - 1) as u8);
         *s = [v.x, v.y, v.z];
     }
-    let mut sys = System {
+    Ok(System {
         proxy,
         region,
         shifts,
@@ -641,7 +662,7 @@ pub(super) fn compact(
         u: vec![[0.0; 6]; n],
         k: d_eq.iter().map(|d| (0.1f64).sqrt() * d).collect(),
         eps: d_eq.iter().map(|d| params.inflate * d).collect(),
-        lam: lam0,
+        lam,
         x: vec![[0.0; 4]; proxy.len()],
         f: vec![[0.0; 3]; proxy.len()],
         start: Vec::new(),
@@ -652,14 +673,33 @@ pub(super) fn compact(
         tol: params.tolerance * d_min,
         built: false,
         rotations: params.rotations,
-    };
+        weight: vec![0.0; n],
+    })
+}
+
+/// Grows the grains' proxies from scale `lam0` to 1 inside `region`,
+/// moving `centres` and `quats` (FIRE on rigid clumps: see the parent
+/// module).
+///
+/// # Errors
+/// [`Error::NotConverged`] when a growth step of 1e-3 does not relax
+/// (naming the scale reached).
+pub(super) fn compact(
+    grains: &[StarGrain],
+    proxy: &Proxy,
+    region: &Region<'_>,
+    centres: &mut [Vector3<f64>],
+    quats: &mut [UnitQuaternion<f64>],
+    lam0: f64,
+    params: &CompactParams,
+) -> Result<CompactStats> {
+    let mut sys = system(grains, proxy, region, centres, quats, lam0.min(1.0), params)?;
     let mut stats = CompactStats {
         spheres: proxy.len(),
         ..CompactStats::default()
     };
     let mut lam = lam0.min(1.0);
-    sys.lam = lam;
-    if !sys.relax(params.max_iterations, &mut stats) {
+    if !sys.relax(params.max_iterations, &mut stats, Until::Separated) {
         return Err(not_converged(&mut sys, &stats, lam));
     }
     let mut saved = (sys.c.clone(), sys.q.clone());
@@ -668,7 +708,7 @@ pub(super) fn compact(
         let next = (lam + step).min(1.0);
         sys.lam = next;
         sys.built = false;
-        if sys.relax(params.max_iterations, &mut stats) {
+        if sys.relax(params.max_iterations, &mut stats, Until::Separated) {
             stats.steps_accepted += 1;
             lam = next;
             saved = (sys.c.clone(), sys.q.clone());
@@ -691,6 +731,100 @@ pub(super) fn compact(
             step *= 0.5;
         }
     }
+    centres.copy_from_slice(&sys.c);
+    quats.copy_from_slice(&sys.q);
+    Ok(stats)
+}
+
+/// Counters of a gravity settling ([`crate::Settle`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SettleStats {
+    /// FIRE iterations under gravity until every grain was at rest.
+    pub iterations: usize,
+    /// FIRE iterations of the separation after gravity is switched off.
+    pub separation_iterations: usize,
+    /// Neighbour-list builds.
+    pub neighbour_builds: usize,
+    /// Largest net force of a grain at rest, over the lightest grain's weight.
+    pub residual: f64,
+    /// Deepest overlap of proxies at rest under gravity, over `d_min`.
+    pub loaded_overlap_over_d: f64,
+    /// Mean fall of the grain centres (start to end), over the median `d_eq`.
+    pub mean_drop_over_d: f64,
+    /// Largest fall of a grain centre, over the median `d_eq`.
+    pub max_drop_over_d: f64,
+}
+
+/// Settles the grains' full-size proxies under gravity along −z without
+/// friction (FIRE on the overlap energy plus each grain's weight
+/// `weight · d_med · V/V_med`), until every grain's net generalised force
+/// is at most `rest` times the lightest grain's weight; then switches
+/// gravity off and separates the proxies to the compaction's tolerance
+/// (see [`crate::Settle`]).
+///
+/// # Errors
+/// [`Error::NotSettled`] when the grains are not at rest within
+/// `settle.max_iterations`; [`Error::NotConverged`] when the separation
+/// does not relax.
+pub(super) fn settle(
+    grains: &[StarGrain],
+    proxy: &Proxy,
+    region: &Region<'_>,
+    centres: &mut [Vector3<f64>],
+    quats: &mut [UnitQuaternion<f64>],
+    params: &CompactParams,
+    settle: &crate::Settle,
+) -> Result<SettleStats> {
+    let mut sys = system(grains, proxy, region, centres, quats, 1.0, params)?;
+    let vol: Vec<f64> = grains.iter().map(|g| g.volume).collect();
+    let mut sorted = vol.clone();
+    sorted.sort_by(f64::total_cmp);
+    let v_med = sorted[sorted.len() / 2];
+    let v_min = sorted[0];
+    let d_med = (6.0 * v_med / std::f64::consts::PI).cbrt();
+    let unit = settle.weight * d_med / v_med;
+    sys.weight = vol.iter().map(|v| unit * v).collect();
+    let w_min = unit * v_min;
+    let mut compact = CompactStats::default();
+    let at_rest = sys.relax(
+        settle.max_iterations,
+        &mut compact,
+        Until::AtRest(settle.rest * w_min),
+    );
+    let residual = {
+        let (g, _) = sys.body_forces();
+        g.iter()
+            .map(|gi| gi.iter().map(|v| v * v).sum::<f64>().sqrt())
+            .fold(0.0, f64::max)
+            / w_min
+    };
+    let mut stats = SettleStats {
+        iterations: compact.iterations,
+        residual,
+        ..SettleStats::default()
+    };
+    if !at_rest {
+        return Err(Error::NotSettled {
+            iterations: compact.iterations,
+            residual,
+            asked: settle.rest,
+        });
+    }
+    let d_min = grains
+        .iter()
+        .map(StarGrain::equivalent_diameter)
+        .fold(f64::INFINITY, f64::min);
+    stats.loaded_overlap_over_d = sys.worst().max(0.0) / d_min;
+    sys.weight.fill(0.0);
+    let before = compact.iterations;
+    if !sys.relax(params.max_iterations, &mut compact, Until::Separated) {
+        return Err(not_converged(&mut sys, &compact, 1.0));
+    }
+    stats.separation_iterations = compact.iterations - before;
+    stats.neighbour_builds = compact.neighbour_builds;
+    let drops: Vec<f64> = centres.iter().zip(&sys.c).map(|(a, b)| a.z - b.z).collect();
+    stats.mean_drop_over_d = drops.iter().sum::<f64>() / drops.len() as f64 / d_med;
+    stats.max_drop_over_d = drops.iter().copied().fold(0.0, f64::max) / d_med;
     centres.copy_from_slice(&sys.c);
     quats.copy_from_slice(&sys.q);
     Ok(stats)

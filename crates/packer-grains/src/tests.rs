@@ -445,3 +445,146 @@ fn check_and_sampling_see_through_periodic_faces() {
     let walled = occupied(&g, &poses, &corners).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(walled.iter().filter(|&&b| b).count(), 1);
 }
+
+#[test]
+fn settled_packings_rest_low_without_overlap() {
+    let g = ellipsoids(120, 9);
+    let c = container_for(&Container::triaxial(1.0), &g, 0.40).unwrap_or_else(|e| panic!("{e}"));
+    let loose = pack_grains(&g, &c, &GrainPackParams::default()).unwrap_or_else(|e| panic!("{e}"));
+    let params = GrainPackParams {
+        settle: Some(Settle::default()),
+        ..GrainPackParams::default()
+    };
+    let p = pack_grains(&g, &c, &params).unwrap_or_else(|e| panic!("{e}"));
+    let s = p.stats.settle;
+    assert!(s.iterations > 0 && s.residual <= 0.05, "{s:?}");
+    assert!(s.mean_drop_over_d > 0.1, "{s:?}");
+    // the bed sits lower than the loose packing's grains, which fill the cylinder
+    let top = bed_top(&g, &p.poses).unwrap_or_else(|e| panic!("{e}"));
+    let loose_top = bed_top(&g, &loose.poses).unwrap_or_else(|e| panic!("{e}"));
+    let (_, hi) = c.bbox();
+    assert!(
+        top < loose_top - 0.05 * hi.z && top < hi.z,
+        "{top} vs {loose_top}"
+    );
+    let mean_z = |poses: &[Isometry3<f64>]| {
+        poses.iter().map(|q| q.translation.vector.z).sum::<f64>() / poses.len() as f64
+    };
+    assert!(mean_z(&p.poses) < mean_z(&loose.poses));
+    let r = check_grain_overlaps(
+        &g,
+        &p.poses,
+        &c,
+        &CheckParams {
+            resolution: 24,
+            raster_pairs: 0,
+            ..CheckParams::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(r.is_clean(), "{r:?}");
+    // identical for a second run (deterministic)
+    let again = pack_grains(&g, &c, &params).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(again.poses, p.poses);
+}
+
+#[test]
+fn settling_refuses_bad_input() {
+    let g = spheres(30, 1);
+    let c = container_for(&Container::triaxial(1.0), &g, 0.3).unwrap_or_else(|e| panic!("{e}"));
+    for (settle, proxies) in [
+        (
+            Settle {
+                weight: 0.0,
+                ..Settle::default()
+            },
+            48,
+        ),
+        (
+            Settle {
+                weight: f64::NAN,
+                ..Settle::default()
+            },
+            48,
+        ),
+        (
+            Settle {
+                rest: 1.5,
+                ..Settle::default()
+            },
+            48,
+        ),
+        (
+            Settle {
+                max_iterations: 0,
+                ..Settle::default()
+            },
+            48,
+        ),
+        (Settle::default(), 0),
+    ] {
+        let params = GrainPackParams {
+            settle: Some(settle),
+            proxy_spheres: proxies,
+            ..GrainPackParams::default()
+        };
+        assert!(matches!(
+            pack_grains(&g, &c, &params),
+            Err(Error::Parameter { .. })
+        ));
+    }
+    // no floor in a fully periodic cell
+    let cell = Boundary::Periodic {
+        min: Point3::origin(),
+        max: Point3::new(1.0, 1.0, 1.0),
+    };
+    let params = GrainPackParams {
+        settle: Some(Settle::default()),
+        ..GrainPackParams::default()
+    };
+    assert!(matches!(
+        pack_grains_in(&spheres(30, 1), &cell, &params),
+        Err(Error::WrongContainer { .. })
+    ));
+    // a budget too small to come to rest is a structured error
+    let params = GrainPackParams {
+        settle: Some(Settle {
+            max_iterations: 3,
+            ..Settle::default()
+        }),
+        ..GrainPackParams::default()
+    };
+    assert!(matches!(
+        pack_grains(&g, &c, &params),
+        Err(Error::NotSettled { iterations: 3, .. })
+    ));
+    assert!(bed_top(&[], &[]).is_err());
+    assert!(bed_top(&g, &[]).is_err());
+}
+
+#[test]
+fn clump_gaps_close_without_overlap_and_wide_gaps_stay() {
+    let c = Container::walled_box(Vector3::new(10.0, 10.0, 10.0));
+    let one = |r: f64| vec![(Point3::origin(), r)];
+    // grains 0 and 1: a gap of 0.02; grain 2 far away; grain 3 0.01 above the floor
+    let mut shapes = vec![one(1.0), one(1.0), one(1.0), one(1.0)];
+    let at = |x: f64, y: f64, z: f64| Isometry3::translation(x, y, z);
+    let poses = [
+        at(3.0, 3.0, 5.0),
+        at(5.02, 3.0, 5.0),
+        at(8.5, 8.5, 5.0),
+        at(7.0, 5.0, 1.01),
+    ];
+    let r =
+        close_clump_gaps(&mut shapes, &poses, |k| k, &c, 0.05).unwrap_or_else(|e| panic!("{e}"));
+    let gap01 = 2.02 - shapes[0][0].1 - shapes[1][0].1;
+    assert!(gap01.abs() < 1e-4 * 0.05 && gap01 >= 0.0, "{gap01}");
+    assert_eq!(shapes[2][0].1, 1.0, "no neighbour within reach: unchanged");
+    let floor = 1.01 - shapes[3][0].1;
+    assert!(floor.abs() < 1e-4 && floor >= 0.0, "{floor}");
+    assert_eq!(r.near_pairs, 1);
+    assert_eq!(r.closed_pairs, 1);
+    assert!(r.volume_change > 0.0 && r.max_growth <= 1.0);
+    assert!(close_clump_gaps(&mut shapes, &poses, |k| k, &c, f64::NAN).is_err());
+    assert!(close_clump_gaps(&mut shapes, &poses, |_| 7, &c, 0.05).is_err());
+}

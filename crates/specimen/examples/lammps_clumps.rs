@@ -17,13 +17,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let clones = specimen::clone_grains(&parents, &params, 200, 200, None, hooks)?;
     let shapes = clones.star_grains()?;
     let grains = clones.grains_of(&shapes);
-    let packed = place::place_grains(&grains, None, Some((0.5, false)), place::Preset::Default, 7)?;
+    let packed = place::place_grains(
+        &grains,
+        None,
+        Some((0.5, false)),
+        place::Preset::Default,
+        7,
+        None,
+    )?;
     let (poses, container) = (&packed.poses, &packed.container);
     specimen::check_grains(&grains, poses, container)?;
     let clump = levelset::ClumpParams::default();
     let (mut spheres, volumes) = specimen::shape_clumps(&clones, Some(&shapes), 45, 1.1, &clump)?;
     let (metres, of) = (1e-6, |k| clones.template_of(k)); // VCCTL scans are in micrometres
-    let c = specimen::clump_templates(&mut spheres, &volumes, poses, of, container, metres)?;
+    let c = specimen::clump_templates(&mut spheres, &volumes, poses, of, container, metres, false)?;
     let s = dem::DemSpecimen {
         templates: &c.templates,
         bodies: &specimen::dem_bodies(poses, of, metres),

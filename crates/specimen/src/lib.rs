@@ -19,7 +19,8 @@
 //!    shape and makes what the outputs ask ([`ShapeOptions`]: LS-DEM morph
 //!    file in its principal frame, multi-sphere clump, DNA, VTU surface);
 //! 5. **clumps**: [`clump_templates`] trims the clumps against every
-//!    copy's neighbours and integrates each union's mass and inertia;
+//!    copy's neighbours (and closes their small gaps in a settled packing)
+//!    and integrates each union's mass and inertia;
 //! 6. **writers** (bytes or `impl Write`, never paths): [`dem`] (LAMMPS,
 //!    LIGGGHTS and Yade decks, [`dem::write_lammps_clump_data`]),
 //!    [`outputs`] (LS-DEM layout, the VTU of the surfaces, `poses.csv`).
@@ -31,7 +32,9 @@
 //! let hooks = cloner::Hooks { clock, progress: None };
 //! let clones = clone_grains(parents, params, 200, 200, None, hooks)?;
 //! let grains = clones.grains_of(&clones.star_grains()?);
-//! let packed = place_grains(&grains, None, Some((0.5, false)), Preset::Default, 7)?;
+//! // settled under gravity (None: spread over the container at the fraction asked)
+//! let settle = Some(packer_grains::Settle::default());
+//! let packed = place_grains(&grains, None, Some((0.5, false)), Preset::Default, 7, settle)?;
 //! check_grains(&grains, &packed.poses, &packed.container)?;
 //! # Ok(()) }
 //! ```
@@ -50,8 +53,8 @@ mod stages;
 
 pub use error::{Context, Error, Result};
 pub use stages::{
-    CLUMP_DNA, Clones, ClumpTemplates, GrainCheck, MORPH_DECIMALS, STAR_FACE_CELLS, ShapeOptions,
-    ShapeOut, SizeRule, SphereCheck, UNION_CELLS, check_bounding_spheres, check_grains,
-    clone_grains, clump_templates, dem_bodies, grain_d_max, scale_container, scale_pose,
-    shape_clumps, shape_outputs,
+    CLUMP_DNA, CLUMP_REACH, Clones, ClumpTemplates, GrainCheck, MORPH_DECIMALS, STAR_FACE_CELLS,
+    ShapeOptions, ShapeOut, SizeRule, SphereCheck, UNION_CELLS, check_bounding_spheres,
+    check_grains, clone_grains, clump_templates, dem_bodies, grain_d_max, scale_container,
+    scale_pose, shape_clumps, shape_outputs,
 };

@@ -19,7 +19,10 @@
 //! packing would).
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
-use packer_grains::{GrainPackParams, GrainPackStats, StarGrain, container_for, pack_grains};
+use packer_grains::{
+    GrainPackParams, GrainPackStats, GrainPacking, Settle, StarGrain, bed_top, container_for,
+    pack_grains,
+};
 use packer_spheres::{Container, Pack3Params};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -170,6 +173,13 @@ fn grain_params(preset: Preset, seed: u64) -> GrainPackParams {
 /// cannot separate the grains ([`GrainPlacement::tries`] > 1 then: the caller
 /// reports the requested and the reached fraction loudly).
 ///
+/// With `settle` the packing is then settled under gravity
+/// ([`packer_grains::Settle`]) and the container's lid (a box's or a
+/// cylinder's top; a mesh is kept) is lowered onto the bed: to
+/// [`bed_top`] plus the packer's wall margin of the largest grain. The
+/// placement's solid fraction is then the settled bed's (grain volume over
+/// the lowered container), not the requested one.
+///
 /// # Errors
 /// No grain; a container smaller than the largest clone's bounding sphere
 /// (naming both sizes); a container the grains cannot be separated in
@@ -180,11 +190,15 @@ pub fn place_grains(
     auto: Option<(f64, bool)>,
     preset: Preset,
     seed: u64,
+    settle: Option<Settle>,
 ) -> Result<GrainPlacement> {
     if grains.is_empty() {
         return Err(Error::Scene("no clone to place".to_owned()));
     }
-    let params = grain_params(preset, seed);
+    let params = GrainPackParams {
+        settle,
+        ..grain_params(preset, seed)
+    };
     let largest = grains.iter().map(|g| 2.0 * g.r_max()).fold(0.0, f64::max);
     let total: f64 = grains.iter().map(StarGrain::volume).sum();
     let too_dense = |e: &packer_grains::Error| {
@@ -203,12 +217,7 @@ pub fn place_grains(
             )));
         }
         return match pack_grains(grains, &c, &params) {
-            Ok(p) => Ok(GrainPlacement {
-                container: c,
-                poses: p.poses,
-                tries: 1,
-                stats: p.stats,
-            }),
+            Ok(p) => finish(grains, c, p, 1, &params),
             Err(e) if too_dense(&e) => {
                 return Err(Error::Scene(format!(
                     "`container` cannot take all {} clones: they fill {:.3} of it and the grain packer cannot separate them ({e}); use a larger container or AutoCylinder",
@@ -228,14 +237,7 @@ pub fn place_grains(
         let room = c.inscribed_diameter();
         if largest <= room {
             match pack_grains(grains, &c, &params) {
-                Ok(p) => {
-                    return Ok(GrainPlacement {
-                        container: c,
-                        poses: p.poses,
-                        tries,
-                        stats: p.stats,
-                    });
-                }
+                Ok(p) => return finish(grains, c, p, tries, &params),
                 Err(e) if too_dense(&e) => {
                     last = match e {
                         // grains at scale λ fill λ³ of their volume
@@ -274,6 +276,41 @@ pub fn place_grains(
         grains.len(),
         fraction / FRACTION_STEP
     )))
+}
+
+/// The placement of a packing; a settled one gets its lid lowered onto the
+/// bed (see [`place_grains`]).
+fn finish(
+    grains: &[StarGrain],
+    container: Container,
+    packing: GrainPacking,
+    tries: usize,
+    params: &GrainPackParams,
+) -> Result<GrainPlacement> {
+    let GrainPacking { poses, mut stats } = packing;
+    let mut container = container;
+    if params.settle.is_some() {
+        let d_max = grains
+            .iter()
+            .map(StarGrain::equivalent_diameter)
+            .fold(0.0, f64::max);
+        let lid = bed_top(grains, &poses)? + params.margin * d_max;
+        match &mut container {
+            Container::Box { max, .. } if lid < max.z => max.z = lid,
+            Container::Cylinder { base, height, .. } if lid < base.z + *height => {
+                *height = lid - base.z;
+            }
+            _ => {}
+        }
+        stats.solid_fraction =
+            grains.iter().map(StarGrain::volume).sum::<f64>() / container.volume();
+    }
+    Ok(GrainPlacement {
+        container,
+        poses,
+        tries,
+        stats,
+    })
 }
 
 /// How much of a specimen the walls hold.
@@ -366,7 +403,8 @@ mod tests {
     #[test]
     fn grains_are_packed_clean_in_auto_and_fixed_containers() {
         let g = ellipsoids(60);
-        let auto = place_grains(&g, None, Some((0.45, false)), Preset::Default, 3).expect("auto");
+        let auto =
+            place_grains(&g, None, Some((0.45, false)), Preset::Default, 3, None).expect("auto");
         assert_eq!(auto.poses.len(), g.len());
         assert!((auto.stats.solid_fraction - 0.45).abs() < 1e-9);
         assert_eq!(auto.tries, 1);
@@ -379,18 +417,49 @@ mod tests {
         .expect("check");
         assert!(r.is_clean(), "{r:?}");
         let fixed = Container::triaxial(12.0);
-        let p = place_grains(&g, Some(fixed.clone()), None, Preset::Dense, 3).expect("fixed");
+        let p = place_grains(&g, Some(fixed.clone()), None, Preset::Dense, 3, None).expect("fixed");
         assert_eq!(format!("{:?}", p.container), format!("{fixed:?}"));
         assert!(p.stats.worst_gap_over_d >= 0.01 * (1.0 - 1e-6));
         // seeded: the same scene gives the same poses
-        let again = place_grains(&g, None, Some((0.45, false)), Preset::Default, 3).expect("auto");
+        let again =
+            place_grains(&g, None, Some((0.45, false)), Preset::Default, 3, None).expect("auto");
         assert_eq!(again.poses, auto.poses);
+    }
+
+    #[test]
+    fn a_settled_placement_lowers_the_lid_onto_a_denser_bed() {
+        let g = ellipsoids(60);
+        let p = place_grains(
+            &g,
+            None,
+            Some((0.40, false)),
+            Preset::Default,
+            3,
+            Some(Settle::default()),
+        )
+        .expect("settled");
+        let Container::Cylinder { height, radius, .. } = p.container else {
+            panic!("a cylinder: {:?}", p.container)
+        };
+        // H = 2 D before: the lid came down, the fraction went up
+        assert!(height < 4.0 * radius * 0.97, "H {height}, R {radius}");
+        assert!(p.stats.solid_fraction > 0.41, "{}", p.stats.solid_fraction);
+        let top = bed_top(&g, &p.poses).expect("top");
+        assert!(top < height, "{top} vs {height}");
+        let r = packer_grains::check_grain_overlaps(
+            &g,
+            &p.poses,
+            &p.container,
+            &packer_grains::CheckParams::default(),
+        )
+        .expect("check");
+        assert!(r.is_clean(), "{r:?}");
     }
 
     #[test]
     fn an_unreachable_auto_fraction_is_an_error_unless_lowering_is_asked() {
         let g = ellipsoids(60);
-        let e = place_grains(&g, None, Some((0.7, false)), Preset::Default, 1)
+        let e = place_grains(&g, None, Some((0.7, false)), Preset::Default, 1, None)
             .err()
             .expect("0.70 is out of reach")
             .to_string();
@@ -399,7 +468,8 @@ mod tests {
                 && e.contains("lower_if_needed"),
             "{e}"
         );
-        let p = place_grains(&g, None, Some((0.6, true)), Preset::Default, 1).expect("lowered");
+        let p =
+            place_grains(&g, None, Some((0.6, true)), Preset::Default, 1, None).expect("lowered");
         assert!(p.tries > 1);
         assert!(p.stats.solid_fraction < 0.6 * 0.95 + 1e-9);
     }
@@ -418,17 +488,31 @@ mod tests {
     #[test]
     fn grain_containers_too_small_or_too_full_are_errors() {
         let g = ellipsoids(60);
-        let e = place_grains(&g, Some(Container::triaxial(1.5)), None, Preset::Default, 1)
-            .err()
-            .expect("too small")
-            .to_string();
+        let e = place_grains(
+            &g,
+            Some(Container::triaxial(1.5)),
+            None,
+            Preset::Default,
+            1,
+            None,
+        )
+        .err()
+        .expect("too small")
+        .to_string();
         assert!(e.contains("too small for the largest clone"), "{e}");
-        let e = place_grains(&g, Some(Container::triaxial(5.0)), None, Preset::Default, 1)
-            .err()
-            .expect("too full")
-            .to_string();
+        let e = place_grains(
+            &g,
+            Some(Container::triaxial(5.0)),
+            None,
+            Preset::Default,
+            1,
+            None,
+        )
+        .err()
+        .expect("too full")
+        .to_string();
         assert!(e.contains("cannot take all 60 clones"), "{e}");
-        let e = place_grains(&[], None, Some((0.5, false)), Preset::Default, 1)
+        let e = place_grains(&[], None, Some((0.5, false)), Preset::Default, 1, None)
             .err()
             .expect("empty")
             .to_string();

@@ -476,6 +476,8 @@ pub struct ClumpTemplates {
     pub unions: Vec<levelset::MassProperties>,
     /// What the trimming did.
     pub trim: packer_grains::ClumpTrim,
+    /// What the gap closing did (settled packings, see [`clump_templates`]).
+    pub reach: Option<packer_grains::ClumpReach>,
     /// Spheres over all clumps.
     pub spheres: usize,
     /// Mean |union volume / level-set volume − 1|.
@@ -484,11 +486,19 @@ pub struct ClumpTemplates {
     pub summed_error: f64,
 }
 
+/// Gaps between clumps closed by [`clump_templates`] for a settled packing,
+/// over the median equivalent diameter.
+pub const CLUMP_REACH: f64 = 0.05;
+
 /// Trims the clumps of the distinct shapes (`spheres[t]`, clone frame)
 /// against every grain's neighbours and the walls
 /// (`packer_grains::separate_clumps`), integrates each union
 /// ([`UNION_CELLS`] cells per equivalent diameter of its level set's
 /// `volumes[t]`) and makes the DEM templates at `metres` per scene unit.
+/// With `close_gaps` (a packing settled under gravity), the gaps between
+/// clumps narrower than [`CLUMP_REACH`] of the median equivalent diameter are
+/// closed after the trimming (`packer_grains::close_clump_gaps`), so that
+/// the bodies a DEM code moves rest on each other where the grains do.
 ///
 /// # Errors
 /// The trimming's or the union integration's errors, naming the clone.
@@ -499,9 +509,27 @@ pub fn clump_templates(
     template_of: impl Fn(usize) -> usize,
     container: &Container,
     metres: f64,
+    close_gaps: bool,
 ) -> Result<ClumpTemplates> {
     let n: usize = spheres.iter().map(Vec::len).sum();
-    let trim = packer_grains::separate_clumps(spheres, poses, template_of, container)?;
+    let trim = packer_grains::separate_clumps(spheres, poses, &template_of, container)?;
+    let reach = if close_gaps {
+        let mut d: Vec<f64> = volumes
+            .iter()
+            .map(|v| (6.0 * v / std::f64::consts::PI).cbrt())
+            .collect();
+        d.sort_by(f64::total_cmp);
+        let d_med = d.get(d.len() / 2).copied().unwrap_or(0.0);
+        Some(packer_grains::close_clump_gaps(
+            spheres,
+            poses,
+            &template_of,
+            container,
+            CLUMP_REACH * d_med,
+        )?)
+    } else {
+        None
+    };
     let unions: Vec<levelset::MassProperties> = spheres
         .par_iter()
         .zip(volumes)
@@ -545,6 +573,7 @@ pub fn clump_templates(
         templates,
         unions,
         trim,
+        reach,
         spheres: n,
         union_error,
         summed_error,

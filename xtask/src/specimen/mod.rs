@@ -477,7 +477,8 @@ fn place_grains_stage(run: &mut Run, grains: &[StarGrain], t: Instant) -> anyhow
     };
     refuse_narrow(scene, &planned, &[], lib::grain_d_max(grains))?;
     let pb = crate::progress::spinner("packing grains", run.quiet);
-    let gp = lib::place::place_grains(grains, fixed, auto, scene.preset, run.seed)?;
+    let settle = scene.settle.then(packer_grains::Settle::default);
+    let gp = lib::place::place_grains(grains, fixed, auto, scene.preset, run.seed, settle)?;
     pb.finish_and_clear();
     let s = gp.stats;
     let requested = auto.map_or(0.0, |a| a.0);
@@ -521,6 +522,23 @@ fn place_grains_stage(run: &mut Run, grains: &[StarGrain], t: Instant) -> anyhow
             s.worst_gap_over_d,
         ),
     );
+    if scene.settle {
+        let st = &s.settle;
+        run.st.note(
+            "place",
+            format!(
+                "settled under gravity (frictionless FIRE): {} iterations to rest (largest net force {:.3} of the lightest grain's weight; loaded overlaps ≤ {:.2e} d_min) + {} to separate; grain centres fell {:.3} d_med on average (at most {:.3}); lid lowered onto the bed: {}, solid fraction {:.4}",
+                st.iterations,
+                st.residual,
+                st.loaded_overlap_over_d,
+                st.separation_iterations,
+                st.mean_drop_over_d,
+                st.max_drop_over_d,
+                describe(&gp.container),
+                s.solid_fraction
+            ),
+        );
+    }
     Ok(Placed {
         container: gp.container,
         poses: gp.poses,
@@ -815,6 +833,7 @@ fn clump_stage(
         |k| clones.template_of(k),
         &placed.container,
         run.scene.metres(),
+        run.scene.settle,
     )?;
     let section = if out.report {
         Some(report::clump_dna_section(
@@ -853,6 +872,20 @@ fn clump_stage(
             100.0 * c.summed_error,
         ),
     );
+    if let Some(r) = &c.reach {
+        run.st.note(
+            "clumps",
+            format!(
+                "settled packing: gaps between clumps below {} d50 closed: {} of {} near pairs of grains now touching; {} radii grown (at most {:.2} of the reach), summed sphere volume {:+.2} %",
+                lib::CLUMP_REACH,
+                r.closed_pairs,
+                r.near_pairs,
+                r.grown,
+                r.max_growth,
+                100.0 * r.volume_change
+            ),
+        );
+    }
     Ok((c.templates, section))
 }
 

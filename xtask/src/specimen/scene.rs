@@ -23,6 +23,9 @@
 //!                                  // or Box(x: 2500.0, y: 2500.0, z: 2500.0); lengths in the parents' unit
 //!     placement: Grains,           // dense packing of the grains themselves (pack_grains),
 //!                                  // or BoundingSpheres (loose: one sphere per grain)
+//!     settle: false,               // true: settle the packing under gravity (frictionless)
+//!                                  // and lower the lid onto the bed: what a DEM code
+//!                                  // loads under gravity then stays put
 //!     preset: Default,             // or Dense (the sphere packer's presets: the bounding
 //!                                  // spheres, or the grain packer's skeleton)
 //!     level_set_resolution: 45,    // nodes per axis of each output level set
@@ -88,6 +91,14 @@ pub(crate) struct Scene {
     /// How the clones are placed.
     #[serde(default)]
     pub(crate) placement: Placement,
+    /// Settle the grain packing under gravity (−z) before anything is written
+    /// (`packer_grains::Settle`: frictionless, until every grain is at rest on its
+    /// contacts), then lower the container's lid onto the bed; the specimen's solid
+    /// fraction is then the settled bed's. For specimens a DEM code will load under
+    /// gravity: they do not compact further there. `placement: Grains` and a walled
+    /// container only.
+    #[serde(default)]
+    pub(crate) settle: bool,
     /// The sphere packer's preset (bounding spheres, or the grain packer's
     /// skeleton).
     #[serde(default)]
@@ -433,6 +444,11 @@ impl Scene {
                 positive("container.y", *y)?;
                 positive("container.z", *z)?;
             }
+        }
+        if self.settle && self.placement != Placement::Grains {
+            bail!(
+                "{at}: `settle: true` settles the grain packing: it needs `placement: Grains` (bounding spheres are not settled)"
+            );
         }
         if !(5..=400).contains(&self.level_set_resolution) {
             bail!(

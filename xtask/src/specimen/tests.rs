@@ -317,6 +317,16 @@ fn bad_scenes_name_the_key_or_file_and_write_nothing() {
         ),
     );
     assert!(e.contains("cannot take all 20 clones"), "{e}");
+    // a settling of bounding spheres
+    let text = scene_text(&config, &out, AUTO, "").replace(
+        "Scene(",
+        "Scene(\n    settle: true,\n    placement: BoundingSpheres,",
+    );
+    let e = bad(&dir, &text);
+    assert!(
+        e.contains("`settle: true`") && e.contains("placement: Grains"),
+        "{e}"
+    );
     // Files parents without their length unit
     let text = scene_text(&config, &out, AUTO, "").replace(
         "Scene(",
