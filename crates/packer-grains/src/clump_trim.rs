@@ -201,7 +201,9 @@ const REACH_PASSES: usize = 10;
 /// closest approach grow by half of their nearest gap to any other grain's
 /// sphere (never into a wall), in [`REACH_PASSES`] passes, so that no pair
 /// can come to overlap (each side takes at most half of every gap) and the
-/// closest spheres of the pair end touching; only those spheres grow; grains that copy one shape
+/// closest spheres of the pair end touching; so does every sphere closer
+/// than `reach` to a wall (the walls carry a narrow container's grains as
+/// much as the floor does); only those spheres grow; grains that copy one shape
 /// grow its sphere by the smallest growth any copy allows. Gaps wider than
 /// `reach` are left alone. Run after [`separate_clumps`].
 ///
@@ -350,8 +352,8 @@ impl GapScan {
 }
 
 /// One pass of [`close_clump_gaps`]: the spheres of each near pair's closest
-/// approach and each grain's sphere nearest a wall grow by what every copy of
-/// their shape allows; whether any grew.
+/// approach and every sphere within reach of a wall grow by what every copy
+/// of their shape allows; whether any grew.
 fn grow(
     shapes: &mut [Vec<(Point3<f64>, f64)>],
     grown: &mut [Vec<f64>],
@@ -366,23 +368,17 @@ fn grow(
         .map(|s| vec![f64::INFINITY; s.len()])
         .collect();
     let mut want: Vec<Vec<bool>> = shapes.iter().map(|s| vec![false; s.len()]).collect();
-    // each grain's sphere closest to a wall, when within reach
-    let mut wall_at: BTreeMap<usize, (f64, usize)> = BTreeMap::new();
     for (i, a) in spheres.iter().enumerate() {
         let wall = container.clearance(&a.0) - a.1;
         let cap = &mut allow[a.3][a.4];
         *cap = cap.min((0.5 * scan.nearest[i]).min(wall).max(0.0));
-        if wall < reach {
-            let e = wall_at.entry(a.2).or_insert((f64::INFINITY, i));
-            if wall < e.0 {
-                *e = (wall, i);
-            }
-        }
     }
     let open = |gap: f64| gap > 1e-9 * reach && gap.is_finite();
-    for &(gap, i) in wall_at.values() {
-        if open(gap) {
-            want[spheres[i].3][spheres[i].4] = true;
+    // every sphere within reach of a wall (floor, side walls, lid)
+    for a in spheres {
+        let wall = container.clearance(&a.0) - a.1;
+        if wall < reach && open(wall) {
+            want[a.3][a.4] = true;
         }
     }
     for &(gap, i, j) in scan.pair_at.values() {

@@ -109,8 +109,8 @@
 //! code's gravity compacts it (a 200-clone cylinder packed at 0.50 settled
 //! to a bed fraction 0.05 higher in LAMMPS and Yade); a settled one is
 //! already supported. What a DEM code moves is still a different body (a
-//! multi-sphere clump inside the margin): `close_clump_gaps` closes the
-//! clumps' small gaps (200 clones: the bed then moves by 0.010–0.012 in
+//! multi-sphere clump inside the margin): [`close_clump_gaps`] closes the
+//! clumps' small gaps (200 clones: the bed then moves by 0.006–0.007 in
 //! LAMMPS, LIGGGHTS and Yade).
 //!
 //! Why: the skeleton gives a uniform, wall-hugging arrangement of the right
