@@ -199,7 +199,7 @@ const REACH_PASSES: usize = 10;
 /// layer by layer (a settled bed compacts by the sum of them). For every pair
 /// of grains whose clumps come closer than `reach`, the two spheres of its
 /// closest approach grow by half of their nearest gap to any other grain's
-/// sphere (never into a wall), in [`REACH_PASSES`] passes, so that no pair
+/// sphere (never into a wall), in 10 passes, so that no pair
 /// can come to overlap (each side takes at most half of every gap) and the
 /// closest spheres of the pair end touching; so does every sphere closer
 /// than `reach` to a wall (the walls carry a narrow container's grains as
