@@ -340,7 +340,23 @@ impl Grid {
 
     #[inline]
     fn trilinear(&self, p: &Point3<f64>) -> f64 {
-        let ([i, j, k], [tx, ty, tz]) = self.locate(p);
+        let (c, t) = self.locate(p);
+        self.cell_trilinear(c, t)
+    }
+
+    /// Trilinear value in the cell whose lower node is `[i, j, k]`, at the
+    /// fractions `t` of the cell along x, y and z (for callers that locate
+    /// their points themselves, e.g. once per axis of a resampling); `None`
+    /// when the cell's upper node lies outside the grid.
+    #[inline]
+    pub fn cell_value(&self, cell: [usize; 3], t: [f64; 3]) -> Option<f64> {
+        let d = self.spec.dims;
+        (cell[0] + 1 < d[0] && cell[1] + 1 < d[1] && cell[2] + 1 < d[2])
+            .then(|| self.cell_trilinear(cell, t))
+    }
+
+    #[inline]
+    fn cell_trilinear(&self, [i, j, k]: [usize; 3], [tx, ty, tz]: [f64; 3]) -> f64 {
         let nx = self.spec.dims[0];
         let sy = nx;
         let sz = nx * self.spec.dims[1];

@@ -313,21 +313,12 @@ fn resample(grid: &Grid, spec: &GridSpec) -> Vec<f64> {
             .collect()
     };
     let (ax, ay, az) = (axis(0), axis(1), axis(2));
-    let [nx, ny, _] = src.dims;
-    let (sy, sz) = (nx, nx * ny);
-    let v = grid.values();
     let mut out = Vec::with_capacity(spec.len());
     for &(k, tz, oz) in &az {
         for &(j, ty, oy) in &ay {
             for &(i, tx, ox) in &ax {
-                let b = i + sy * j + sz * k;
-                let c00 = v[b] + tx * (v[b + 1] - v[b]);
-                let c10 = v[b + sy] + tx * (v[b + sy + 1] - v[b + sy]);
-                let c01 = v[b + sz] + tx * (v[b + sz + 1] - v[b + sz]);
-                let c11 = v[b + sy + sz] + tx * (v[b + sy + sz + 1] - v[b + sy + sz]);
-                let c0 = c00 + ty * (c10 - c00);
-                let c1 = c01 + ty * (c11 - c01);
-                let inside = c0 + tz * (c1 - c0);
+                // every cell is inside: `axis` clamps it to n − 2
+                let inside = grid.cell_value([i, j, k], [tx, ty, tz]).unwrap_or(f64::NAN);
                 let d2 = ox * ox + oy * oy + oz * oz;
                 out.push(if d2 > 0.0 { inside + d2.sqrt() } else { inside });
             }

@@ -50,39 +50,7 @@ pub fn separate_clumps(
     shape_of: impl Fn(usize) -> usize,
     container: &Container,
 ) -> Result<ClumpTrim> {
-    // every sphere of every grain in the world: (centre, radius, grain, template, sphere)
-    let spheres: Vec<(Point3<f64>, f64, usize, usize, usize)> = poses
-        .iter()
-        .enumerate()
-        .flat_map(|(g, pose)| {
-            let t = shape_of(g);
-            shapes[t]
-                .iter()
-                .enumerate()
-                .map(move |(m, (c, r))| (pose * c, *r, g, t, m))
-        })
-        .collect();
-    for (k, p) in poses.iter().enumerate() {
-        if !p.translation.vector.iter().all(|v| v.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "pose translation",
-                value: p
-                    .translation
-                    .vector
-                    .iter()
-                    .copied()
-                    .find(|v| !v.is_finite())
-                    .unwrap_or(f64::NAN),
-            });
-        }
-        if shape_of(k) >= shapes.len() {
-            return Err(Error::Parameter {
-                what: "shape index of a pose",
-                value: shape_of(k) as f64,
-                range: "below the number of shapes",
-            });
-        }
-    }
+    check_poses(shapes.len(), poses, &shape_of)?;
     for s in shapes.iter() {
         for (c, r) in s {
             if !(r.is_finite() && *r > 0.0 && c.coords.iter().all(|v| v.is_finite())) {
@@ -93,6 +61,7 @@ pub fn separate_clumps(
             }
         }
     }
+    let spheres = world_spheres(shapes, poses, &shape_of);
     let mut trim = ClumpTrim::default();
     let Some(r_max) = spheres.iter().map(|s| s.1).reduce(f64::max) else {
         return Ok(trim);
@@ -224,21 +193,7 @@ pub fn close_clump_gaps(
             range: "(0, inf)",
         });
     }
-    for (k, p) in poses.iter().enumerate() {
-        if !p.translation.vector.iter().all(|v| v.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "pose translation",
-                value: f64::NAN,
-            });
-        }
-        if shape_of(k) >= shapes.len() {
-            return Err(Error::Parameter {
-                what: "shape index of a pose",
-                value: shape_of(k) as f64,
-                range: "below the number of shapes",
-            });
-        }
-    }
+    check_poses(shapes.len(), poses, &shape_of)?;
     let before: f64 = shapes.iter().flatten().map(|(_, r)| r.powi(3)).sum();
     let mut out = ClumpReach::default();
     let mut grown: Vec<Vec<f64>> = shapes.iter().map(|s| vec![0.0; s.len()]).collect();
@@ -268,6 +223,36 @@ pub fn close_clump_gaps(
     let after: f64 = shapes.iter().flatten().map(|(_, r)| r.powi(3)).sum();
     out.volume_change = after / before - 1.0;
     Ok(out)
+}
+
+/// Finite pose translations, and a shape index below `shapes` for every pose.
+fn check_poses(
+    shapes: usize,
+    poses: &[Isometry3<f64>],
+    shape_of: &impl Fn(usize) -> usize,
+) -> Result<()> {
+    for (k, p) in poses.iter().enumerate() {
+        if !p.translation.vector.iter().all(|v| v.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "pose translation",
+                value: p
+                    .translation
+                    .vector
+                    .iter()
+                    .copied()
+                    .find(|v| !v.is_finite())
+                    .unwrap_or(f64::NAN),
+            });
+        }
+        if shape_of(k) >= shapes {
+            return Err(Error::Parameter {
+                what: "shape index of a pose",
+                value: shape_of(k) as f64,
+                range: "below the number of shapes",
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A world sphere: centre, radius, grain, shape, sphere of the shape.
@@ -368,15 +353,12 @@ fn grow(
         .map(|s| vec![f64::INFINITY; s.len()])
         .collect();
     let mut want: Vec<Vec<bool>> = shapes.iter().map(|s| vec![false; s.len()]).collect();
+    let open = |gap: f64| gap > 1e-9 * reach && gap.is_finite();
     for (i, a) in spheres.iter().enumerate() {
         let wall = container.clearance(&a.0) - a.1;
         let cap = &mut allow[a.3][a.4];
         *cap = cap.min((0.5 * scan.nearest[i]).min(wall).max(0.0));
-    }
-    let open = |gap: f64| gap > 1e-9 * reach && gap.is_finite();
-    // every sphere within reach of a wall (floor, side walls, lid)
-    for a in spheres {
-        let wall = container.clearance(&a.0) - a.1;
+        // every sphere within reach of a wall (floor, side walls, lid)
         if wall < reach && open(wall) {
             want[a.3][a.4] = true;
         }

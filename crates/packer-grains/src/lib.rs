@@ -620,22 +620,7 @@ pub fn random_rotation(rng: &mut impl Rng) -> UnitQuaternion<f64> {
 /// [`Error::Empty`] without grains; [`Error::Parameter`] when the counts of
 /// grains and poses differ; [`Error::NonFinite`] for a non-finite pose.
 pub fn bed_top(grains: &[StarGrain], poses: &[Isometry3<f64>]) -> Result<f64> {
-    if grains.is_empty() {
-        return Err(Error::Empty { what: "grain list" });
-    }
-    if poses.len() != grains.len() {
-        return Err(Error::Parameter {
-            what: "poses (one per grain)",
-            value: poses.len() as f64,
-            range: "the number of grains",
-        });
-    }
-    for p in poses {
-        finite(
-            "pose",
-            p.translation.vector.norm() + p.rotation.coords.norm(),
-        )?;
-    }
+    check_poses(grains, poses)?;
     let top = grains
         .par_iter()
         .zip(poses)
@@ -1126,12 +1111,8 @@ pub fn occupied_in(
     occupied_impl(grains, poses, Some(&Region::new(boundary)), points)
 }
 
-fn occupied_impl(
-    grains: &[StarGrain],
-    poses: &[Isometry3<f64>],
-    region: Option<&Region<'_>>,
-    points: &[Point3<f64>],
-) -> Result<Vec<bool>> {
+/// Grains given, one finite pose per grain.
+fn check_poses(grains: &[StarGrain], poses: &[Isometry3<f64>]) -> Result<()> {
     if grains.is_empty() {
         return Err(Error::Empty { what: "grain list" });
     }
@@ -1150,6 +1131,16 @@ fn occupied_impl(
             finite("pose rotation", p.rotation.coords[k])?;
         }
     }
+    Ok(())
+}
+
+fn occupied_impl(
+    grains: &[StarGrain],
+    poses: &[Isometry3<f64>],
+    region: Option<&Region<'_>>,
+    points: &[Point3<f64>],
+) -> Result<Vec<bool>> {
+    check_poses(grains, poses)?;
     for p in points {
         for k in 0..3 {
             finite("sample point", p[k])?;
