@@ -323,8 +323,8 @@ struct System<'a> {
 enum Until {
     /// No overlap deeper than the tolerance (the compaction).
     Separated,
-    /// Every body at rest: its net generalised force `(F, τ/k)` at most
-    /// this (a settling under the weights).
+    /// The bodies at rest: their mean net generalised force `(F, τ/k)` at
+    /// most this times their mean weight (a settling under the weights).
     AtRest(f64),
 }
 
@@ -450,26 +450,7 @@ impl System<'_> {
                     }
                     if walled[i] {
                         let p = Point3::new(a[0], a[1], a[2]);
-                        let cl = region.clearance(&p);
-                        if cl < a[3] {
-                            let ov = a[3] - cl;
-                            worst = worst.max(ov);
-                            let h = 1e-4 * a[3];
-                            let mut g = [0.0; 3];
-                            for k in 0..3 {
-                                let mut e = p;
-                                let mut w = p;
-                                e[k] += h;
-                                w[k] -= h;
-                                g[k] = (region.clearance(&e) - region.clearance(&w)) / (2.0 * h);
-                            }
-                            let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-                            if len > 0.0 {
-                                for c in 0..3 {
-                                    acc[c] += ov * g[c] / len;
-                                }
-                            }
-                        }
+                        worst = worst.max(region.wall_push(&p, a[3], &mut acc));
                     }
                     *f = acc;
                 }
@@ -555,18 +536,10 @@ impl System<'_> {
                 return true;
             }
             let (g, s) = self.body_forces();
-            if let Until::AtRest(ftol) = until {
-                let rest = g
-                    .par_chunks(CHUNK)
-                    .map(|gs| {
-                        gs.iter()
-                            .map(|gi| gi.iter().map(|v| v * v).sum::<f64>())
-                            .fold(0.0, f64::max)
-                    })
-                    .reduce(|| 0.0, f64::max);
-                if rest <= ftol * ftol {
-                    return true;
-                }
+            if let Until::AtRest(ftol) = until
+                && self.unbalance(&g).0 <= ftol
+            {
+                return true;
             }
             if it == max_iter {
                 break;
@@ -607,6 +580,23 @@ impl System<'_> {
                 });
         }
         false
+    }
+
+    /// The settling's out-of-balance ratios: the mean net generalised force
+    /// `|(F, τ/k)|` of the bodies over their mean weight, and the largest
+    /// net force of a body over its own weight.
+    fn unbalance(&self, g: &[[f64; 6]]) -> (f64, f64) {
+        let (sum, max) = g
+            .par_chunks(CHUNK)
+            .zip(self.weight.par_chunks(CHUNK))
+            .map(|(gs, ws)| {
+                gs.iter().zip(ws).fold((0.0, 0.0f64), |(s, m), (gi, w)| {
+                    let n = gi.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    (s + n, m.max(n / w))
+                })
+            })
+            .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)));
+        (sum / self.weight.iter().sum::<f64>(), max)
     }
 
     /// Largest overlap of the current state (neighbour list rebuilt).
@@ -739,14 +729,18 @@ pub(super) fn compact(
 /// Counters of a gravity settling ([`crate::Settle`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SettleStats {
-    /// FIRE iterations under gravity until every grain was at rest.
+    /// FIRE iterations under gravity until the grains were at rest.
     pub iterations: usize,
     /// FIRE iterations of the separation after gravity is switched off.
     pub separation_iterations: usize,
     /// Neighbour-list builds.
     pub neighbour_builds: usize,
-    /// Largest net force of a grain at rest, over the lightest grain's weight.
+    /// Out-of-balance ratio at rest: the grains' mean net force over their
+    /// mean weight.
     pub residual: f64,
+    /// Largest net force of a grain at rest, over its own weight (grains
+    /// still sliding slowly on the bed's surface, which friction holds).
+    pub max_residual: f64,
     /// Deepest overlap of proxies at rest under gravity, over `d_min`.
     pub loaded_overlap_over_d: f64,
     /// Mean fall of the grain centres (start to end), over the median `d_eq`.
@@ -757,8 +751,8 @@ pub struct SettleStats {
 
 /// Settles the grains' full-size proxies under gravity along −z without
 /// friction (FIRE on the overlap energy plus each grain's weight
-/// `weight · d_med · V/V_med`), until every grain's net generalised force
-/// is at most `rest` times the lightest grain's weight; then switches
+/// `weight · d_med · V/V_med`), until the grains' mean net generalised
+/// force is at most `rest` times their mean weight; then switches
 /// gravity off and separates the proxies to the compaction's tolerance
 /// (see [`crate::Settle`]).
 ///
@@ -780,27 +774,23 @@ pub(super) fn settle(
     let mut sorted = vol.clone();
     sorted.sort_by(f64::total_cmp);
     let v_med = sorted[sorted.len() / 2];
-    let v_min = sorted[0];
     let d_med = (6.0 * v_med / std::f64::consts::PI).cbrt();
     let unit = settle.weight * d_med / v_med;
     sys.weight = vol.iter().map(|v| unit * v).collect();
-    let w_min = unit * v_min;
     let mut compact = CompactStats::default();
     let at_rest = sys.relax(
         settle.max_iterations,
         &mut compact,
-        Until::AtRest(settle.rest * w_min),
+        Until::AtRest(settle.rest),
     );
-    let residual = {
+    let (residual, max_residual) = {
         let (g, _) = sys.body_forces();
-        g.iter()
-            .map(|gi| gi.iter().map(|v| v * v).sum::<f64>().sqrt())
-            .fold(0.0, f64::max)
-            / w_min
+        sys.unbalance(&g)
     };
     let mut stats = SettleStats {
         iterations: compact.iterations,
         residual,
+        max_residual,
         ..SettleStats::default()
     };
     if !at_rest {

@@ -104,15 +104,15 @@ pub enum Error {
         /// The highest overlap-free fraction reached.
         reached: f64,
     },
-    /// A gravity settling ([`crate::Settle`]) did not bring every grain to
+    /// A gravity settling ([`crate::Settle`]) did not bring the grains to
     /// rest within its iteration budget.
     #[error(
-        "the grains did not come to rest under gravity in {iterations} FIRE iterations: the largest net force left is {residual:.3e} of the lightest grain's weight (asked: {asked:.3e}); raise `Settle::max_iterations`"
+        "the grains did not come to rest under gravity in {iterations} FIRE iterations: the grains' mean net force left is {residual:.3e} of their mean weight (asked: {asked:.3e}); raise `Settle::max_iterations`"
     )]
     NotSettled {
         /// FIRE iterations run.
         iterations: usize,
-        /// Largest net force of a grain over the lightest grain's weight.
+        /// Mean net force of the grains over their mean weight.
         residual: f64,
         /// The asked bound, same unit.
         asked: f64,

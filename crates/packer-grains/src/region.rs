@@ -58,6 +58,80 @@ impl<'a> Region<'a> {
         self.walls.map_or(f64::INFINITY, |c| c.clearance(p))
     }
 
+    /// Wall contact forces on a sphere of radius `r` at `p`, added to `acc`
+    /// (unit stiffness: overlap times the wall's inward normal); returns
+    /// the deepest overlap (`−inf` without contact).
+    ///
+    /// Each wall is a separate contact, as in a DEM code: the floor, the
+    /// lid and each non-periodic side of a box are half-spaces, a
+    /// cylinder's mantle is the infinite cylinder. So a sphere pressed into
+    /// a corner feels both walls, and the energy is smooth there (a force
+    /// from the nearest wall only would jump between the walls at the
+    /// corner's bisector and never come to rest). A mesh container has no
+    /// faces to tell apart: its contact is the nearest wall's, along the
+    /// clearance gradient.
+    #[inline]
+    pub(crate) fn wall_push(&self, p: &Point3<f64>, r: f64, acc: &mut [f64; 3]) -> f64 {
+        let mut worst = f64::NEG_INFINITY;
+        let mut push = |ov: f64, n: [f64; 3], acc: &mut [f64; 3]| {
+            if ov > 0.0 {
+                worst = worst.max(ov);
+                for k in 0..3 {
+                    acc[k] += ov * n[k];
+                }
+            }
+        };
+        match self.walls {
+            None => {}
+            Some(Container::Box { min, max, periodic }) => {
+                for k in 0..3 {
+                    if k < 2 && periodic[k] {
+                        continue;
+                    }
+                    let mut n = [0.0; 3];
+                    n[k] = 1.0;
+                    push(r - (p[k] - min[k]), n, acc);
+                    n[k] = -1.0;
+                    push(r - (max[k] - p[k]), n, acc);
+                }
+            }
+            Some(Container::Cylinder {
+                base,
+                radius,
+                height,
+            }) => {
+                push(r - (p.z - base.z), [0.0, 0.0, 1.0], acc);
+                push(r - (base.z + height - p.z), [0.0, 0.0, -1.0], acc);
+                let (dx, dy) = (p.x - base.x, p.y - base.y);
+                let rho = dx.hypot(dy);
+                if rho > 0.0 {
+                    push(r - (radius - rho), [-dx / rho, -dy / rho, 0.0], acc);
+                }
+            }
+            Some(c @ Container::Mesh(_)) => {
+                let cl = c.clearance(p);
+                if cl < r {
+                    let h = 1e-4 * r;
+                    let mut g = [0.0; 3];
+                    for k in 0..3 {
+                        let mut e = *p;
+                        let mut w = *p;
+                        e[k] += h;
+                        w[k] -= h;
+                        g[k] = (c.clearance(&e) - c.clearance(&w)) / (2.0 * h);
+                    }
+                    let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+                    if len > 0.0 {
+                        push(r - cl, [g[0] / len, g[1] / len, g[2] / len], acc);
+                    } else {
+                        worst = worst.max(r - cl);
+                    }
+                }
+            }
+        }
+        worst
+    }
+
     /// Whether any axis is periodic.
     pub(crate) fn is_periodic(&self) -> bool {
         self.period.iter().any(|&p| p)
@@ -227,5 +301,60 @@ mod tests {
             Region::new(&free).clearance(&Point3::new(5.0, 5.0, 5.0)),
             f64::INFINITY
         );
+    }
+
+    #[test]
+    fn every_wall_is_a_separate_contact() {
+        // a sphere in the corner between floor and mantle feels both walls
+        let cyl = Container::Cylinder {
+            base: Point3::origin(),
+            radius: 2.0,
+            height: 5.0,
+        };
+        let r = Region::of(&cyl);
+        let mut acc = [0.0; 3];
+        let worst = r.wall_push(&Point3::new(1.6, 0.0, 0.3), 0.5, &mut acc);
+        assert!((worst - 0.2).abs() < 1e-12, "{worst}");
+        assert!(
+            (acc[0] + 0.1).abs() < 1e-12 && acc[1].abs() < 1e-12,
+            "{acc:?}"
+        );
+        assert!((acc[2] - 0.2).abs() < 1e-12, "{acc:?}");
+        // the force is continuous across the corner's bisector
+        let f = |x: f64| {
+            let mut a = [0.0; 3];
+            r.wall_push(&Point3::new(2.0 - x, 0.0, x), 0.5, &mut a);
+            a
+        };
+        let (a, b) = (f(0.3 - 1e-9), f(0.3 + 1e-9));
+        assert!((0..3).all(|k| (a[k] - b[k]).abs() < 1e-8), "{a:?} {b:?}");
+        // no contact: nothing added
+        let mut none = [0.0; 3];
+        assert_eq!(
+            r.wall_push(&Point3::new(0.0, 0.0, 2.5), 0.5, &mut none),
+            f64::NEG_INFINITY
+        );
+        assert_eq!(none, [0.0; 3]);
+        // a box corner: three walls; a periodic axis has none
+        let bx = Container::Box {
+            min: Point3::origin(),
+            max: Point3::new(4.0, 4.0, 4.0),
+            periodic: [true, false],
+        };
+        let mut acc = [0.0; 3];
+        Region::of(&bx).wall_push(&Point3::new(0.1, 0.2, 3.7), 0.5, &mut acc);
+        assert!(acc[0].abs() < 1e-12, "{acc:?}");
+        assert!(
+            (acc[1] - 0.3).abs() < 1e-12 && (acc[2] + 0.2).abs() < 1e-12,
+            "{acc:?}"
+        );
+        // fully periodic: no walls
+        let free = Boundary::Periodic {
+            min: Point3::origin(),
+            max: Point3::new(1.0, 1.0, 1.0),
+        };
+        let mut acc = [0.0; 3];
+        Region::new(&free).wall_push(&Point3::new(0.0, 0.0, 0.0), 0.5, &mut acc);
+        assert_eq!(acc, [0.0; 3]);
     }
 }

@@ -363,6 +363,7 @@ fn clone_stage(run: &mut Run, parents: &cloner::Parents) -> anyhow::Result<lib::
         format!(
             "{} clones of `{}`{} ({} candidates, acceptance {:.1} %); level sets kept: no, DNA measured: {}",
             c.clones.len(),
+            run.cal.name,
             if scene.distinct_shapes.is_some() {
                 format!(
                     " as the distinct shapes of {} grains (grain k a copy of clone k mod {})",
@@ -372,7 +373,6 @@ fn clone_stage(run: &mut Run, parents: &cloner::Parents) -> anyhow::Result<lib::
             } else {
                 String::new()
             },
-            run.cal.name,
             c.stats.attempts,
             100.0 * c.stats.acceptance_rate(),
             if scene.outputs.report { "yes (report)" } else { "no" }
@@ -527,9 +527,10 @@ fn place_grains_stage(run: &mut Run, grains: &[StarGrain], t: Instant) -> anyhow
         run.st.note(
             "place",
             format!(
-                "settled under gravity (frictionless FIRE): {} iterations to rest (largest net force {:.3} of the lightest grain's weight; loaded overlaps ≤ {:.2e} d_min) + {} to separate; grain centres fell {:.3} d_med on average (at most {:.3}); lid lowered onto the bed: {}, solid fraction {:.4}",
+                "settled under gravity (frictionless FIRE): {} iterations to rest (mean net force {:.4} of the mean weight, largest {:.3} of a grain's own; loaded overlaps ≤ {:.2e} d_min) + {} to separate; grain centres fell {:.3} d_med on average (at most {:.3}); lid lowered onto the bed: {}, solid fraction {:.4}",
                 st.iterations,
                 st.residual,
+                st.max_residual,
                 st.loaded_overlap_over_d,
                 st.separation_iterations,
                 st.mean_drop_over_d,
