@@ -374,6 +374,8 @@ fn the_example_scenes_parse() {
         "specimen-clumps.ron",
         "specimen-lsdem.ron",
         "specimen-10k.ron",
+        "specimen-dense.ron",
+        "specimen-settled-2000.ron",
     ] {
         let p = root().join("examples").join(name);
         let s = Scene::read(&p).unwrap_or_else(|e| panic!("{name}: {e:#}"));
