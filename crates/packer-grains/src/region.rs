@@ -111,25 +111,29 @@ impl<'a> Region<'a> {
             Some(c @ Container::Mesh(_)) => {
                 let cl = c.clearance(p);
                 if cl < r {
-                    let h = 1e-4 * r;
-                    let mut g = [0.0; 3];
-                    for k in 0..3 {
-                        let mut e = *p;
-                        let mut w = *p;
-                        e[k] += h;
-                        w[k] -= h;
-                        g[k] = (c.clearance(&e) - c.clearance(&w)) / (2.0 * h);
-                    }
-                    let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-                    if len > 0.0 {
-                        push(r - cl, [g[0] / len, g[1] / len, g[2] / len], acc);
-                    } else {
-                        worst = worst.max(r - cl);
+                    match self.inward(p, 1e-4 * r) {
+                        Some(n) => push(r - cl, [n.x, n.y, n.z], acc),
+                        None => worst = worst.max(r - cl),
                     }
                 }
             }
         }
         worst
+    }
+
+    /// The unit inward normal of the nearest wall at `p`: the clearance's
+    /// gradient by central differences of step `h` (`None` where it
+    /// vanishes).
+    pub(crate) fn inward(&self, p: &Point3<f64>, h: f64) -> Option<Vector3<f64>> {
+        let mut g = Vector3::zeros();
+        for k in 0..3 {
+            let (mut e, mut w) = (*p, *p);
+            e[k] += h;
+            w[k] -= h;
+            g[k] = (self.clearance(&e) - self.clearance(&w)) / (2.0 * h);
+        }
+        let len = g.norm();
+        (len > 0.0).then(|| g / len)
     }
 
     /// Whether any axis is periodic.

@@ -843,16 +843,9 @@ fn wall_projection(
         if cl >= mu {
             break;
         }
-        let h = 1e-4 * frame.d_eq[i];
-        let mut g = Vector3::zeros();
-        for a in 0..3 {
-            let mut e = Vector3::zeros();
-            e[a] = h;
-            g[a] =
-                (region.clearance(&(x + e).into()) - region.clearance(&(x - e).into())) / (2.0 * h);
-        }
-        let len = g.norm();
-        let g = if len > 0.0 { g / len } else { Vector3::z() };
+        let g = region
+            .inward(&x.into(), 1e-4 * frame.d_eq[i])
+            .unwrap_or_else(Vector3::z);
         p += (mu - cl + OVERSHOOT * mu) * g;
         changed = true;
     }
