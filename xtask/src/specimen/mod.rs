@@ -956,10 +956,12 @@ fn deck_stages(
                 plan.max_steps,
                 plan.ke_limit,
                 plan.packed_fraction
-            ) + &if name == "liggghts" && s.templates.len() > LIGGGHTS_TEMPLATES {
+            ) + &if name == "liggghts" && s.templates.len() > lib::dem::LIGGGHTS_BATCH {
                 format!(
-                    "; warning: {} templates — LIGGGHTS 3.8's set-up grows with the cube of the number of multisphere templates (its template-type check; 200 start in seconds, 2000 had not started after 70 min); share shapes (`distinct_shapes`) for LIGGGHTS",
-                    s.templates.len()
+                    "; {} templates defined and inserted in {} batches of at most {} (LIGGGHTS 3.8's template set-up grows with the cube of the templates defined at once)",
+                    s.templates.len(),
+                    s.templates.len().div_ceil(lib::dem::LIGGGHTS_BATCH),
+                    lib::dem::LIGGGHTS_BATCH
                 )
             } else {
                 String::new()
@@ -968,14 +970,6 @@ fn deck_stages(
     }
     Ok(())
 }
-
-/// Multisphere templates above which the LIGGGHTS deck's set-up is slow:
-/// LIGGGHTS-PUBLIC's `FixTemplateMultisphere::init` (run for every template)
-/// checks that every pair of templates has distinct types, each look-up a
-/// `Modify::find_fix_style_strict` scan over all fixes — T³·F string
-/// comparisons for T templates and F fixes. Measured: 200 templates start in
-/// seconds; a 2,000-template deck was still there after 70 min (gdb).
-const LIGGGHTS_TEMPLATES: usize = 500;
 
 /// The DNA and grading report with its plots.
 fn report_stage(

@@ -18,6 +18,18 @@ use crate::error::Result;
 /// pose. A one-sphere template is a `particletemplate/sphere` (multisphere templates need
 /// two spheres) integrated by `nve/sphere`.
 ///
+/// The templates are defined and their bodies inserted in batches of at most
+/// [`LIGGGHTS_BATCH`] templates: each batch's fixes, one step that inserts its bodies,
+/// then its insertion, distribution and template fixes removed (the bodies keep their
+/// mass, inertia and spheres). LIGGGHTS 3.8's set-up of `particletemplate/multisphere`
+/// (`FixTemplateMultisphere::init`, run for every template at every `run`) checks every
+/// pair of templates for distinct types with a scan of all fixes per look-up: T³·F work
+/// for T templates and F fixes, so 2,000 templates defined at once had not started after
+/// 70 min; in batches of 100 they start in seconds. Multisphere types are consecutive from
+/// 1 within a batch (LIGGGHTS requires it of the templates defined at one time). Bodies
+/// are inserted batch by batch, so LIGGGHTS numbers them in that order (the body order
+/// when every template fits one batch).
+///
 /// # Errors
 /// As [`DemSpecimen::plan`].
 pub fn liggghts_files(s: &DemSpecimen) -> Result<Vec<(String, Vec<u8>)>> {
@@ -26,9 +38,19 @@ pub fn liggghts_files(s: &DemSpecimen) -> Result<Vec<(String, Vec<u8>)>> {
     for b in s.bodies {
         used[b.template] += 1;
     }
+    // batch of each used template: its rank among the used ones over the batch size
+    let mut batch_of = vec![usize::MAX; s.templates.len()];
+    for (rank, k) in (0..s.templates.len()).filter(|&k| used[k] > 0).enumerate() {
+        batch_of[k] = rank / LIGGGHTS_BATCH;
+    }
+    let batches = batch_of
+        .iter()
+        .filter(|b| **b != usize::MAX)
+        .max()
+        .map_or(0, |b| b + 1);
     let mut seeds = Seeds(primes(3 * s.templates.len() + s.bodies.len() + 1).into_iter());
-    let (mut files, tpl) = templates(s, &used, &mut seeds);
-    let (ins, unfix) = inserts(s, &p, &mut seeds);
+    let (mut files, tpl) = templates(s, &used, &batch_of, batches, &mut seeds);
+    let (ins, unfix) = inserts(s, &p, &batch_of, batches, &mut seeds);
     let singles = s
         .templates
         .iter()
@@ -52,6 +74,9 @@ pub fn liggghts_files(s: &DemSpecimen) -> Result<Vec<(String, Vec<u8>)>> {
     files.push(("liggghts/in.settle".into(), deck.into_bytes()));
     Ok(files)
 }
+
+/// Most templates the LIGGGHTS deck defines at one time (see [`liggghts_files`]).
+pub const LIGGGHTS_BATCH: usize = 100;
 
 /// The first `n` primes above 10⁵ (LIGGGHTS wants prime seeds above 10⁴).
 fn primes(n: usize) -> Vec<u64> {
@@ -79,22 +104,39 @@ impl Seeds {
     }
 }
 
+/// Per batch: its template and distribution fixes, and their `unfix` lines.
+struct BatchFixes {
+    define: Vec<String>,
+    remove: Vec<String>,
+}
+
 /// The sphere files of the multisphere templates used (`liggghts/template-T.txt`) and the
-/// deck's template and distribution fixes of every template used.
+/// deck's template and distribution fixes of every template used, per batch.
 fn templates(
     s: &DemSpecimen,
     used: &[usize],
+    batch_of: &[usize],
+    batches: usize,
     seeds: &mut Seeds,
-) -> (Vec<(String, Vec<u8>)>, String) {
+) -> (Vec<(String, Vec<u8>)>, BatchFixes) {
     let m = s.material;
     let mut files = Vec::new();
-    let mut tpl = String::new();
-    let mut ms_type = 0usize;
+    let mut out = BatchFixes {
+        define: vec![String::new(); batches],
+        remove: vec![String::new(); batches],
+    };
+    let mut ms_types = vec![0usize; batches];
     for (k, t) in s.templates.iter().enumerate() {
         if used[k] == 0 {
             continue;
         }
         let k1 = k + 1;
+        let batch = batch_of[k];
+        let tpl = &mut out.define[batch];
+        let _ = writeln!(
+            out.remove[batch],
+            "unfix           pdd{k1}\nunfix           pts{k1}"
+        );
         if t.spheres.len() == 1 {
             let _ = writeln!(
                 tpl,
@@ -111,8 +153,9 @@ fn templates(
                 let _ = writeln!(text, "{:e} {:e} {:e} {:e}", d.x, d.y, d.z, r);
             }
             files.push((format!("liggghts/{name}"), text.into_bytes()));
-            // multisphere types are consecutive from 1
-            ms_type += 1;
+            // multisphere types are consecutive from 1 within a batch
+            ms_types[batch] += 1;
+            let ms_type = ms_types[batch];
             let i = t.inertia * m.density;
             let _ = writeln!(
                 tpl,
@@ -135,18 +178,27 @@ fn templates(
             seeds.next()
         );
     }
-    (files, tpl)
+    (files, out)
 }
 
 /// One `insert/pack` per body of one particle in a tiny sphere around its centre of mass at
-/// its packed orientation, and the `unfix` lines of the insertions.
-fn inserts(s: &DemSpecimen, p: &Plan, seeds: &mut Seeds) -> (String, String) {
-    let mut ins = String::new();
-    let mut unfix = String::new();
+/// its packed orientation, and the `unfix` lines of the insertions, per batch of its
+/// template.
+fn inserts(
+    s: &DemSpecimen,
+    p: &Plan,
+    batch_of: &[usize],
+    batches: usize,
+    seeds: &mut Seeds,
+) -> (Vec<String>, Vec<String>) {
+    let mut all_ins = vec![String::new(); batches];
+    let mut all_unfix = vec![String::new(); batches];
     let tiny = 1e-6 * p.d50;
     for (k, b) in s.bodies.iter().enumerate() {
         let t = &s.templates[b.template];
         let k1 = k + 1;
+        let batch = batch_of[b.template];
+        let (ins, unfix) = (&mut all_ins[batch], &mut all_unfix[batch]);
         let c = b.pose * t.centroid;
         let q = b.pose.rotation.quaternion();
         let group = if t.spheres.len() == 1 {
@@ -170,7 +222,7 @@ fn inserts(s: &DemSpecimen, p: &Plan, seeds: &mut Seeds) -> (String, String) {
         );
         let _ = writeln!(unfix, "unfix           ins{k1}");
     }
-    (ins, unfix)
+    (all_ins, all_unfix)
 }
 
 /// The `wall/gran` fixes of the container's walls.
@@ -213,12 +265,12 @@ fn wall_fixes(c: &Container) -> Result<String> {
 
 /// The pieces of the deck made before it.
 struct Parts {
-    /// Template and distribution fixes.
-    tpl: String,
-    /// Insertion regions and fixes.
-    ins: String,
-    /// The insertions' `unfix` lines.
-    unfix: String,
+    /// Template and distribution fixes, per batch.
+    tpl: BatchFixes,
+    /// Insertion regions and fixes, per batch.
+    ins: Vec<String>,
+    /// The insertions' `unfix` lines, per batch.
+    unfix: Vec<String>,
     /// Wall fixes.
     walls: String,
     /// The simulation box.
@@ -294,7 +346,8 @@ compute         pgl all pair/gran/local delta
     );
 }
 
-/// The templates, the integrators, the insertions, one step that inserts, and the unfixes.
+/// The integrators, then per batch: the templates, the insertions, one step that inserts,
+/// and the unfixes.
 fn deck_insert(deck: &mut String, parts: &Parts) {
     let ms = if parts.multi {
         "fix             ms all multisphere\n"
@@ -306,13 +359,19 @@ fn deck_insert(deck: &mut String, parts: &Parts) {
     } else {
         ""
     };
-    let _ = write!(
-        deck,
-        "{tpl}{ms}{nve}{ins}run             1\n{unfix}",
-        tpl = parts.tpl,
-        ins = parts.ins,
-        unfix = parts.unfix,
-    );
+    let n = parts.ins.len();
+    let _ = write!(deck, "{ms}{nve}");
+    for b in 0..n {
+        let _ = write!(
+            deck,
+            "# insertion batch {} of {n}\n{tpl}{ins}run             1\n{unfix}{remove}",
+            b + 1,
+            tpl = parts.tpl.define[b],
+            ins = parts.ins[b],
+            unfix = parts.unfix[b],
+            remove = parts.tpl.remove[b],
+        );
+    }
 }
 
 /// The kinetic energy `ke` of the bodies: multisphere bodies, one-sphere bodies or both.

@@ -409,3 +409,101 @@ fn refuses_bad_input() {
     };
     assert!(liggghts_files(&s).is_err());
 }
+
+/// Walks a LIGGGHTS deck's fixes: every `unfix` names a fix alive, every insertion's
+/// distribution is alive, and the multisphere templates alive at each `run` have types
+/// 1..n (LIGGGHTS' check) with n ≤ the batch size. Returns the number of insertion
+/// steps and the bodies inserted.
+fn walk_liggghts_deck(deck: &str) -> (usize, usize) {
+    use std::collections::BTreeMap;
+    let mut alive: BTreeMap<String, Option<usize>> = BTreeMap::new();
+    let (mut steps, mut inserted) = (0, 0);
+    for l in deck.lines() {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        match w.first() {
+            Some(&"fix") => {
+                let ms_type = w
+                    .iter()
+                    .position(|x| *x == "type")
+                    .filter(|_| l.contains("particletemplate/multisphere"))
+                    .map(|i| w[i + 1].parse::<usize>().expect("type"));
+                if let Some(i) = w.iter().position(|x| *x == "distributiontemplate") {
+                    assert!(alive.contains_key(w[i + 1]), "{l}: distribution not alive");
+                    inserted += 1;
+                }
+                assert!(
+                    alive.insert(w[1].to_owned(), ms_type).is_none(),
+                    "{l}: twice"
+                );
+            }
+            Some(&"unfix") => {
+                assert!(alive.remove(w[1]).is_some(), "{l}: not alive");
+            }
+            Some(&"run") if w[1] == "1" => {
+                steps += 1;
+                let mut types: Vec<usize> = alive.values().flatten().copied().collect();
+                types.sort_unstable();
+                assert!(
+                    types.len() <= LIGGGHTS_BATCH,
+                    "{} templates alive",
+                    types.len()
+                );
+                assert_eq!(types, (1..=types.len()).collect::<Vec<_>>());
+            }
+            _ => {}
+        }
+    }
+    assert!(
+        alive
+            .keys()
+            .all(|k| !k.starts_with("pts") && !k.starts_with("pdd") && !k.starts_with("ins")),
+        "template, distribution or insertion fixes left: {alive:?}"
+    );
+    (steps, inserted)
+}
+
+#[test]
+fn liggghts_defines_templates_in_batches() {
+    // 250 distinct two-sphere templates and a one-sphere one, 260 bodies
+    let mut templates: Vec<Template> = (0..250)
+        .map(|k| {
+            let r = 1e-4 * (1.0 + 1e-3 * k as f64);
+            template(vec![
+                (Point3::new(-0.5 * r, 0.0, 0.0), r),
+                (Point3::new(0.5 * r, 0.0, 0.0), r),
+            ])
+        })
+        .collect();
+    templates.push(one());
+    let b = bodies(templates.len(), 260);
+    let material = Material::default();
+    let prov = vec!["grainforge test".to_owned()];
+    let container = Container::Cylinder {
+        base: Point3::origin(),
+        radius: 5e-3,
+        height: 0.1,
+    };
+    let s = DemSpecimen {
+        templates: &templates,
+        bodies: &b,
+        container: &container,
+        material: &material,
+        provenance: &prov,
+    };
+    let f: Vec<(String, String)> = liggghts_files(&s)
+        .expect("files")
+        .into_iter()
+        .map(|(p, b)| (p, String::from_utf8(b).expect("utf-8")))
+        .collect();
+    let deck = get(&f, "liggghts/in.settle");
+    let (steps, inserted) = walk_liggghts_deck(deck);
+    assert_eq!(steps, 3, "251 templates in batches of {LIGGGHTS_BATCH}");
+    assert_eq!(inserted, 260);
+    assert_eq!(deck.matches("particletemplate/multisphere").count(), 250);
+    // one batch: the bodies inserted in the body order, one step
+    let small = files(liggghts_files, &[pair(), one()], &cylinder());
+    assert_eq!(
+        walk_liggghts_deck(get(&small, "liggghts/in.settle")),
+        (1, 4)
+    );
+}
