@@ -381,7 +381,7 @@ impl System {
     /// FIRE until the largest overlap is at most the tolerance; `false`
     /// when `max_iter` iterations did not get there.
     pub(super) fn relax(&mut self, max_iter: usize, stats: &mut DensifyStats) -> bool {
-        let mut fire = FireControl::new(0.1, 0.5);
+        let mut fire = FireControl::with_delay(0.1, 0.5, FireControl::N_DELAY_2);
         for v in &mut self.v {
             *v = [0.0; 3];
         }
@@ -400,7 +400,21 @@ impl System {
                 break;
             }
             stats.iterations += 1;
+            let dt_last = fire.dt();
             let (mix, a, dt) = fire.update(s.power, s.vv, s.ff);
+            if mix.is_none() {
+                // FIRE 2.0: half of the last step back before the velocities are zeroed
+                self.xr
+                    .par_chunks_mut(CHUNK)
+                    .zip(self.v.par_chunks(CHUNK))
+                    .for_each(|(xs, vs)| {
+                        for (x, v) in xs.iter_mut().zip(vs) {
+                            for k in 0..3 {
+                                x[k] -= 0.5 * dt_last * v[k];
+                            }
+                        }
+                    });
+            }
             let periods = self.geom.periods();
             // velocity mixing, semi-implicit Euler, and whether a centre left half the skin
             stale = self
