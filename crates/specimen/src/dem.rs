@@ -71,7 +71,7 @@ mod liggghts;
 mod yade;
 
 pub use lammps::{lammps_files, write_lammps_clump_data};
-pub use liggghts::{LIGGGHTS_BATCH, liggghts_files};
+pub use liggghts::{LIGGGHTS_BATCH, liggghts_batches, liggghts_files};
 pub use yade::yade_files;
 
 /// Steps between two kinetic-energy checks.

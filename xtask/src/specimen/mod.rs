@@ -956,11 +956,11 @@ fn deck_stages(
                 plan.max_steps,
                 plan.ke_limit,
                 plan.packed_fraction
-            ) + &if name == "liggghts" && s.templates.len() > lib::dem::LIGGGHTS_BATCH {
+            ) + &if name == "liggghts" && lib::dem::liggghts_batches(&s) > 1 {
                 format!(
                     "; {} templates defined and inserted in {} batches of at most {} (LIGGGHTS 3.8's template set-up grows with the cube of the templates defined at once)",
                     s.templates.len(),
-                    s.templates.len().div_ceil(lib::dem::LIGGGHTS_BATCH),
+                    lib::dem::liggghts_batches(&s),
                     lib::dem::LIGGGHTS_BATCH
                 )
             } else {

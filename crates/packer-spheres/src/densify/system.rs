@@ -402,21 +402,9 @@ impl System {
             stats.iterations += 1;
             let dt_last = fire.dt();
             let (mix, a, dt) = fire.update(s.power, s.vv, s.ff);
-            if mix.is_none() {
-                // FIRE 2.0: half of the last step back before the velocities are zeroed
-                self.xr
-                    .par_chunks_mut(CHUNK)
-                    .zip(self.v.par_chunks(CHUNK))
-                    .for_each(|(xs, vs)| {
-                        for (x, v) in xs.iter_mut().zip(vs) {
-                            for k in 0..3 {
-                                x[k] -= 0.5 * dt_last * v[k];
-                            }
-                        }
-                    });
-            }
             let periods = self.geom.periods();
-            // velocity mixing, semi-implicit Euler, and whether a centre left half the skin
+            // velocity mixing (or FIRE 2.0's half step back), semi-implicit Euler, and whether a
+            // centre left half the skin
             stale = self
                 .v
                 .par_chunks_mut(CHUNK)
@@ -429,7 +417,12 @@ impl System {
                         for k in 0..3 {
                             v[k] = match mix {
                                 Some(m) => (1.0 - a) * v[k] + m * f[k],
-                                None => 0.0,
+                                None => {
+                                    // FIRE 2.0: half of the last step back before the
+                                    // velocity is zeroed
+                                    x[k] -= 0.5 * dt_last * v[k];
+                                    0.0
+                                }
                             } + dt * f[k];
                             x[k] += dt * v[k];
                         }

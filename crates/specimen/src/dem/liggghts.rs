@@ -43,14 +43,10 @@ pub fn liggghts_files(s: &DemSpecimen) -> Result<Vec<(String, Vec<u8>)>> {
     for (rank, k) in (0..s.templates.len()).filter(|&k| used[k] > 0).enumerate() {
         batch_of[k] = rank / LIGGGHTS_BATCH;
     }
-    let batches = batch_of
-        .iter()
-        .filter(|b| **b != usize::MAX)
-        .max()
-        .map_or(0, |b| b + 1);
+    let mut batches = vec![Batch::default(); liggghts_batches(s)];
     let mut seeds = Seeds(primes(3 * s.templates.len() + s.bodies.len() + 1).into_iter());
-    let (mut files, tpl) = templates(s, &used, &batch_of, batches, &mut seeds);
-    let (ins, unfix) = inserts(s, &p, &batch_of, batches, &mut seeds);
+    let mut files = templates(s, &used, &batch_of, &mut batches, &mut seeds);
+    inserts(s, &p, &batch_of, &mut batches, &mut seeds);
     let singles = s
         .templates
         .iter()
@@ -62,9 +58,7 @@ pub fn liggghts_files(s: &DemSpecimen) -> Result<Vec<(String, Vec<u8>)>> {
         .zip(&used)
         .any(|(t, u)| *u > 0 && t.spheres.len() > 1);
     let parts = Parts {
-        tpl,
-        ins,
-        unfix,
+        batches,
         walls: wall_fixes(s.container)?,
         bounds: geometry(s.container)?.2,
         singles,
@@ -77,6 +71,18 @@ pub fn liggghts_files(s: &DemSpecimen) -> Result<Vec<(String, Vec<u8>)>> {
 
 /// Most templates the LIGGGHTS deck defines at one time (see [`liggghts_files`]).
 pub const LIGGGHTS_BATCH: usize = 100;
+
+/// The insertion batches of the LIGGGHTS deck of `s`: its templates used by a body, in
+/// batches of [`LIGGGHTS_BATCH`].
+pub fn liggghts_batches(s: &DemSpecimen) -> usize {
+    let mut used = vec![false; s.templates.len()];
+    for b in s.bodies {
+        if let Some(u) = used.get_mut(b.template) {
+            *u = true;
+        }
+    }
+    used.iter().filter(|u| **u).count().div_ceil(LIGGGHTS_BATCH)
+}
 
 /// The first `n` primes above 10⁵ (LIGGGHTS wants prime seeds above 10⁴).
 fn primes(n: usize) -> Vec<u64> {
@@ -104,10 +110,17 @@ impl Seeds {
     }
 }
 
-/// Per batch: its template and distribution fixes, and their `unfix` lines.
-struct BatchFixes {
-    define: Vec<String>,
-    remove: Vec<String>,
+/// One insertion batch of the deck.
+#[derive(Clone, Default)]
+struct Batch {
+    /// Its template and distribution fixes.
+    define: String,
+    /// Its insertion regions and fixes.
+    insert: String,
+    /// The `unfix` lines of its insertions.
+    unfix_inserts: String,
+    /// The `unfix` lines of its distributions and templates.
+    unfix_templates: String,
 }
 
 /// The sphere files of the multisphere templates used (`liggghts/template-T.txt`) and the
@@ -116,27 +129,23 @@ fn templates(
     s: &DemSpecimen,
     used: &[usize],
     batch_of: &[usize],
-    batches: usize,
+    batches: &mut [Batch],
     seeds: &mut Seeds,
-) -> (Vec<(String, Vec<u8>)>, BatchFixes) {
+) -> Vec<(String, Vec<u8>)> {
     let m = s.material;
     let mut files = Vec::new();
-    let mut out = BatchFixes {
-        define: vec![String::new(); batches],
-        remove: vec![String::new(); batches],
-    };
-    let mut ms_types = vec![0usize; batches];
+    let mut ms_types = vec![0usize; batches.len()];
     for (k, t) in s.templates.iter().enumerate() {
         if used[k] == 0 {
             continue;
         }
         let k1 = k + 1;
         let batch = batch_of[k];
-        let tpl = &mut out.define[batch];
         let _ = writeln!(
-            out.remove[batch],
+            batches[batch].unfix_templates,
             "unfix           pdd{k1}\nunfix           pts{k1}"
         );
+        let tpl = &mut batches[batch].define;
         if t.spheres.len() == 1 {
             let _ = writeln!(
                 tpl,
@@ -178,7 +187,7 @@ fn templates(
             seeds.next()
         );
     }
-    (files, out)
+    files
 }
 
 /// One `insert/pack` per body of one particle in a tiny sphere around its centre of mass at
@@ -188,17 +197,14 @@ fn inserts(
     s: &DemSpecimen,
     p: &Plan,
     batch_of: &[usize],
-    batches: usize,
+    batches: &mut [Batch],
     seeds: &mut Seeds,
-) -> (Vec<String>, Vec<String>) {
-    let mut all_ins = vec![String::new(); batches];
-    let mut all_unfix = vec![String::new(); batches];
+) {
     let tiny = 1e-6 * p.d50;
     for (k, b) in s.bodies.iter().enumerate() {
         let t = &s.templates[b.template];
         let k1 = k + 1;
-        let batch = batch_of[b.template];
-        let (ins, unfix) = (&mut all_ins[batch], &mut all_unfix[batch]);
+        let batch = &mut batches[batch_of[b.template]];
         let c = b.pose * t.centroid;
         let q = b.pose.rotation.quaternion();
         let group = if t.spheres.len() == 1 {
@@ -207,7 +213,7 @@ fn inserts(
             "all"
         };
         let _ = writeln!(
-            ins,
+            batch.insert,
             "region          r{k1} sphere {:e} {:e} {:e} {tiny:e} units box volume_limit 1e-30\n\
              fix             ins{k1} {group} insert/pack seed {} distributiontemplate pdd{} insert_every once overlapcheck no orientation constant {:.15} {:.15} {:.15} {:.15} region r{k1} particles_in_region 1",
             c.x,
@@ -220,9 +226,8 @@ fn inserts(
             q.j,
             q.k
         );
-        let _ = writeln!(unfix, "unfix           ins{k1}");
+        let _ = writeln!(batch.unfix_inserts, "unfix           ins{k1}");
     }
-    (all_ins, all_unfix)
 }
 
 /// The `wall/gran` fixes of the container's walls.
@@ -265,12 +270,8 @@ fn wall_fixes(c: &Container) -> Result<String> {
 
 /// The pieces of the deck made before it.
 struct Parts {
-    /// Template and distribution fixes, per batch.
-    tpl: BatchFixes,
-    /// Insertion regions and fixes, per batch.
-    ins: Vec<String>,
-    /// The insertions' `unfix` lines, per batch.
-    unfix: Vec<String>,
+    /// The insertion batches.
+    batches: Vec<Batch>,
     /// Wall fixes.
     walls: String,
     /// The simulation box.
@@ -359,17 +360,17 @@ fn deck_insert(deck: &mut String, parts: &Parts) {
     } else {
         ""
     };
-    let n = parts.ins.len();
+    let n = parts.batches.len();
     let _ = write!(deck, "{ms}{nve}");
-    for b in 0..n {
+    for (b, batch) in parts.batches.iter().enumerate() {
         let _ = write!(
             deck,
-            "# insertion batch {} of {n}\n{tpl}{ins}run             1\n{unfix}{remove}",
+            "# insertion batch {} of {n}\n{}{}run             1\n{}{}",
             b + 1,
-            tpl = parts.tpl.define[b],
-            ins = parts.ins[b],
-            unfix = parts.unfix[b],
-            remove = parts.tpl.remove[b],
+            batch.define,
+            batch.insert,
+            batch.unfix_inserts,
+            batch.unfix_templates,
         );
     }
 }

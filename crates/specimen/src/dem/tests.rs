@@ -498,6 +498,7 @@ fn liggghts_defines_templates_in_batches() {
     let deck = get(&f, "liggghts/in.settle");
     let (steps, inserted) = walk_liggghts_deck(deck);
     assert_eq!(steps, 3, "251 templates in batches of {LIGGGHTS_BATCH}");
+    assert_eq!(liggghts_batches(&s), steps);
     assert_eq!(inserted, 260);
     assert_eq!(deck.matches("particletemplate/multisphere").count(), 250);
     // one batch: the bodies inserted in the body order, one step
