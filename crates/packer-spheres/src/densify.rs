@@ -56,12 +56,19 @@
 //! proportional to the contact count, a preconditioner, took 4,600–5,100); a Verlet neighbour list with skin 0.25 `d_min`,
 //! rebuilt when a sphere moved more than half of it, spheres renumbered in
 //! cell order at each build and each pair's periodic image stored as a
-//! shift code (no minimum-image test in the force loop);
+//! shift code (no minimum-image test in the force loop); each pair listed
+//! once, from its lower-numbered sphere (a build scans only the cells of
+//! higher number, half of the candidates), and its force computed once,
+//! stored, and taken with the opposite sign by the other sphere in a second
+//! pass (Newton's third law: half of the square roots and divisions, the
+//! force pass's cost; 10⁴ spheres to 0.64: −30 % wall time with the
+//! half-scan build and no wall test in a periodic box);
 //! compression about the domain's centre (isotropic, so the front's
 //! fabric is not sheared).
 //!
 //! # Determinism
-//! Forces are summed per sphere over its neighbour list in a fixed order,
+//! Forces are summed per sphere in a fixed order (its own pairs in list
+//! order, then the stored forces of the pairs it is the higher sphere of),
 //! and every global sum (power, norms) is over fixed chunks of 1024 spheres
 //! added in order, so the result is identical for any thread count.
 

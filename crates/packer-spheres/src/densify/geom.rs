@@ -178,6 +178,17 @@ impl Geom {
         }
     }
 
+    /// Whether any side is a wall (a fully periodic box has none).
+    pub(super) fn has_walls(&self) -> bool {
+        !matches!(
+            self,
+            Self::Box {
+                periodic: [true, true, true],
+                ..
+            }
+        )
+    }
+
     /// The wall force on a sphere (overlap times the inward normal, summed
     /// over walls) and its largest wall overlap.
     pub(super) fn wall(&self, p: &[f64], r: f64) -> ([f64; 3], f64) {

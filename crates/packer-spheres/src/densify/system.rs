@@ -31,9 +31,16 @@ pub(super) struct System {
     v: Vec<[f64; 3]>,
     f: Vec<[f64; 3]>,
     pub(super) geom: Geom,
-    /// Neighbour list (CSR, both directions).
+    /// Neighbour list, each pair once from its lower-numbered sphere (CSR,
+    /// each sphere's entries in increasing neighbour index).
     start: Vec<u32>,
     list: Vec<u32>,
+    /// For each sphere, the entries of `list` in which it is the higher-numbered
+    /// sphere (CSR, in increasing entry order).
+    lstart: Vec<u32>,
+    lref: Vec<u32>,
+    /// Force of each listed pair on its lower sphere (the higher one takes the opposite).
+    pf: Vec<[f64; 3]>,
     /// Centres at the last build.
     x_build: Vec<[f64; 3]>,
     /// Input index of each sphere (the spheres are kept in cell order).
@@ -78,6 +85,9 @@ impl System {
             geom,
             start: Vec::new(),
             list: Vec::new(),
+            lstart: Vec::new(),
+            lref: Vec::new(),
+            pf: Vec::new(),
             x_build: Vec::new(),
             ids: (0..n as u32).collect(),
             skin: 0.25 * d_min,
@@ -208,11 +218,14 @@ impl System {
             }
             (v, m)
         };
-        let lists: Vec<Vec<u32>> = (0..xr.len())
+        // each pair once, from the sphere of the lower index: the spheres are numbered in cell
+        // order, so a neighbouring cell of a lower number holds only lower indices
+        let upper: Vec<Vec<u32>> = (0..xr.len())
             .into_par_iter()
             .map(|i| {
                 let c = cell_of(&xr[i]);
-                let mut out = Vec::with_capacity(24);
+                let own = (c[2] * dims[1] + c[1]) * dims[0] + c[0];
+                let mut out = Vec::with_capacity(12);
                 let (zs, nz) = span(2, c[2]);
                 let (ys, ny) = span(1, c[1]);
                 let (xs, nx) = span(0, c[0]);
@@ -220,10 +233,15 @@ impl System {
                     for &cy in &ys[..ny] {
                         for &cx in &xs[..nx] {
                             let cell = (cz * dims[1] + cy) * dims[0] + cx;
-                            for j in head[cell] as usize..head[cell + 1] as usize {
-                                if j == i {
-                                    continue;
-                                }
+                            if cell < own {
+                                continue;
+                            }
+                            let first = if cell == own {
+                                i + 1
+                            } else {
+                                head[cell] as usize
+                            };
+                            for j in first..head[cell + 1] as usize {
                                 let d = Self::delta(&periods, &xr[i], &xr[j]);
                                 let cut = xr[i][3] + xr[j][3] + skin;
                                 if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut {
@@ -247,17 +265,37 @@ impl System {
                         }
                     }
                 }
-                out.sort_unstable();
+                out.sort_unstable_by_key(|e| e & INDEX_MASK);
                 out
             })
             .collect();
         self.start.clear();
         self.list.clear();
         self.start.push(0);
-        for l in &lists {
-            self.list.extend_from_slice(l);
+        for u in &upper {
+            self.list.extend_from_slice(u);
             self.start.push(self.list.len() as u32);
         }
+        // each sphere's entries as the higher-numbered sphere, in entry order
+        let n = xr.len();
+        let mut count = vec![0u32; n + 1];
+        for &e in &self.list {
+            count[(e & INDEX_MASK) as usize + 1] += 1;
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        self.lref.clear();
+        self.lref.resize(self.list.len(), 0);
+        let mut fill = count.clone();
+        for (at, &e) in self.list.iter().enumerate() {
+            let j = (e & INDEX_MASK) as usize;
+            self.lref[fill[j] as usize] = at as u32;
+            fill[j] += 1;
+        }
+        self.lstart = count;
+        self.pf.clear();
+        self.pf.resize(self.list.len(), [0.0; 3]);
         self.x_build.clear();
         self.x_build
             .extend(self.xr.iter().map(|p| [p[0], p[1], p[2]]));
@@ -265,35 +303,53 @@ impl System {
     }
 
     /// Forces into `self.f`, with the chunk sums of `F·v`, `|F|²`, `|v|²` and the largest
-    /// overlap (pairs and walls), added in chunk order.
+    /// overlap (pairs and walls), added in chunk order. Two passes: each listed pair once
+    /// (its force added to its lower sphere and stored), then each sphere takes the
+    /// opposite of the stored forces of the pairs in which it is the higher sphere, in a
+    /// fixed order; so every sum is the same for any thread count.
     fn forces(&mut self) -> Sums {
         let shifts = image_shifts(&self.geom.periods());
         let geom = self.geom;
-        let (xr, v, start, list) = (&self.xr, &self.v, &self.start, &self.list);
-        let parts: Vec<Sums> = self
+        let walled = geom.has_walls();
+        let n = self.xr.len();
+        let (xr, start, list) = (&self.xr, &self.start, &self.list);
+        // the stored pair forces of each chunk of spheres: a contiguous range of the list
+        let mut pf_parts: Vec<&mut [[f64; 3]]> = Vec::with_capacity(n.div_ceil(CHUNK));
+        let mut rest: &mut [[f64; 3]] = &mut self.pf;
+        let mut at = 0;
+        for c in 0..n.div_ceil(CHUNK) {
+            let end = start[((c + 1) * CHUNK).min(n)] as usize;
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(end - at);
+            pf_parts.push(head);
+            rest = tail;
+            at = end;
+        }
+        let worst = self
             .f
             .par_chunks_mut(CHUNK)
+            .zip(pf_parts.into_par_iter())
             .enumerate()
-            .map(|(c, fs)| {
-                let mut s = Sums {
-                    power: 0.0,
-                    ff: 0.0,
-                    vv: 0.0,
-                    worst: f64::NEG_INFINITY,
-                };
+            .map(|(c, (fs, pfs))| {
+                let base = start[c * CHUNK] as usize;
+                let mut chunk_worst = f64::NEG_INFINITY;
                 for (o, f) in fs.iter_mut().enumerate() {
                     let i = c * CHUNK + o;
                     let a = &xr[i];
-                    let (mut acc, ow) = geom.wall(a, a[3]);
+                    let (mut acc, ow) = if walled {
+                        geom.wall(a, a[3])
+                    } else {
+                        ([0.0; 3], f64::NEG_INFINITY)
+                    };
                     let mut worst = ow;
+                    let (e0, e1) = (start[i] as usize, start[i + 1] as usize);
                     // branch-free, two pairs at a time (the square roots and divisions of
                     // the two pairs go through the vector units together): half of the
                     // listed pairs touch, unpredictably
-                    let nb = &list[start[i] as usize..start[i + 1] as usize];
-                    let mut pairs = nb.chunks_exact(2);
+                    let mut pairs = list[e0..e1].chunks_exact(2);
+                    let mut outs = pfs[e0 - base..e1 - base].chunks_exact_mut(2);
                     let mut acc2 = [[0.0f64; 2]; 3];
                     let mut worst2 = [f64::NEG_INFINITY; 2];
-                    for jj in &mut pairs {
+                    for (jj, out) in (&mut pairs).zip(&mut outs) {
                         let (b0, s0) = (
                             &xr[(jj[0] & INDEX_MASK) as usize],
                             &shifts[(jj[0] >> INDEX_BITS) as usize],
@@ -326,12 +382,16 @@ impl System {
                             (if ov[0] > 0.0 { ov[0] } else { 0.0 }) / dist[0],
                             (if ov[1] > 0.0 { ov[1] } else { 0.0 }) / dist[1],
                         ];
+                        let g0 = [k[0] * d0[0], k[0] * d0[1], k[0] * d0[2]];
+                        let g1 = [k[1] * d1[0], k[1] * d1[1], k[1] * d1[2]];
                         for c in 0..3 {
-                            acc2[c][0] += k[0] * d0[c];
-                            acc2[c][1] += k[1] * d1[c];
+                            acc2[c][0] += g0[c];
+                            acc2[c][1] += g1[c];
                         }
+                        out[0] = g0;
+                        out[1] = g1;
                     }
-                    for &j in pairs.remainder() {
+                    for (&j, out) in pairs.remainder().iter().zip(outs.into_remainder()) {
                         let (b, sh) = (
                             &xr[(j & INDEX_MASK) as usize],
                             &shifts[(j >> INDEX_BITS) as usize],
@@ -345,16 +405,44 @@ impl System {
                         let ov = a[3] + b[3] - dist;
                         worst2[0] = if ov > worst2[0] { ov } else { worst2[0] };
                         let k = (if ov > 0.0 { ov } else { 0.0 }) / dist;
+                        let g = [k * d[0], k * d[1], k * d[2]];
                         for c in 0..3 {
-                            acc2[c][0] += k * d[c];
+                            acc2[c][0] += g[c];
                         }
+                        *out = g;
                     }
                     for c in 0..3 {
                         acc[c] += acc2[c][0] + acc2[c][1];
                     }
                     worst = worst.max(worst2[0]).max(worst2[1]);
                     *f = acc;
-                    s.worst = s.worst.max(worst);
+                    chunk_worst = chunk_worst.max(worst);
+                }
+                chunk_worst
+            })
+            .reduce(|| f64::NEG_INFINITY, f64::max);
+        let (v, pf, lstart, lref) = (&self.v, &self.pf, &self.lstart, &self.lref);
+        let parts: Vec<Sums> = self
+            .f
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .map(|(c, fs)| {
+                let mut s = Sums {
+                    power: 0.0,
+                    ff: 0.0,
+                    vv: 0.0,
+                    worst: f64::NEG_INFINITY,
+                };
+                for (o, f) in fs.iter_mut().enumerate() {
+                    let i = c * CHUNK + o;
+                    let mut acc = *f;
+                    for &e in &lref[lstart[i] as usize..lstart[i + 1] as usize] {
+                        let g = &pf[e as usize];
+                        for c in 0..3 {
+                            acc[c] -= g[c];
+                        }
+                    }
+                    *f = acc;
                     let w = &v[i];
                     s.power += acc[0] * w[0] + acc[1] * w[1] + acc[2] * w[2];
                     s.ff += acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
@@ -367,13 +455,12 @@ impl System {
             power: 0.0,
             ff: 0.0,
             vv: 0.0,
-            worst: f64::NEG_INFINITY,
+            worst,
         };
         for p in &parts {
             t.power += p.power;
             t.ff += p.ff;
             t.vv += p.vv;
-            t.worst = t.worst.max(p.worst);
         }
         t
     }
@@ -402,9 +489,9 @@ impl System {
             stats.iterations += 1;
             let dt_last = fire.dt();
             let (mix, a, dt) = fire.update(s.power, s.vv, s.ff);
-            let periods = self.geom.periods();
             // velocity mixing (or FIRE 2.0's half step back), semi-implicit Euler, and whether a
-            // centre left half the skin
+            // centre left half the skin (centres are wrapped only at a build, so the plain
+            // difference from the build's centre is the displacement)
             stale = self
                 .v
                 .par_chunks_mut(CHUNK)
@@ -426,7 +513,7 @@ impl System {
                             } + dt * f[k];
                             x[k] += dt * v[k];
                         }
-                        let d = Self::delta(&periods, x, b);
+                        let d = [x[0] - b[0], x[1] - b[1], x[2] - b[2]];
                         moved |= d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > lim;
                     }
                     moved
