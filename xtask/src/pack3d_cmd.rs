@@ -281,7 +281,7 @@ impl Run3<'_> {
             text,
             "densified to {} (target {}): front placed {} spheres, {} removed at random for the \
              target, then {} compression steps ({} undone), {} FIRE iterations, {} neighbour \
-             builds, largest overlap before the final expansion ≤ {:.0e} d_min",
+             builds, largest overlap before the final expansion ≤ {:.0e} × the pair's centre distance",
             format_args!("{:.4}", p.fraction),
             match target {
                 Target::Fraction(f) => format!("{f}"),

@@ -16,8 +16,10 @@
 //! 2. **relax**: the overlaps are removed by minimising the harmonic overlap
 //!    energy `E = ½ Σ (r_i + r_j − d_ij)₊² + ½ Σ (r_i − clearance_i)₊²` with
 //!    FIRE (Bitzek et al. 2006, *Phys. Rev. Lett.* 97, 170201: damped
-//!    dynamics with velocity mixing and an adaptive step), until the largest
-//!    overlap is at most [`DensifyParams::tolerance`] · `d_min`. Below
+//!    dynamics with velocity mixing and an adaptive step), until every
+//!    overlap is at most [`DensifyParams::tolerance`] times the pair's centre
+//!    distance (a wall's: times the sphere's clearance), so that one affine
+//!    expansion by `1 + tolerance` at most clears them all. Below
 //!    jamming the minimum has `E = 0` and FIRE reaches it in a few hundred
 //!    steps; at and above jamming it does not;
 //! 3. a step that does not relax within [`DensifyParams::max_iterations`]
@@ -144,10 +146,16 @@ pub struct DensifyParams {
     /// FIRE iterations allowed per compression step (default 20,000; the
     /// relaxation time grows steeply towards jamming).
     pub max_iterations: usize,
-    /// Largest overlap the relaxation may leave, as a fraction of the
-    /// smallest diameter (default 1e-4); a final affine expansion of at most
-    /// this relative size removes it exactly, and the compression aims that
-    /// much higher, so the requested fraction is still met.
+    /// Largest overlap the relaxation may leave, over the pair's centre
+    /// distance (a wall's: over the sphere's clearance), in (0, 1e-3]; a final
+    /// affine expansion by one plus the largest such ratio removes them
+    /// exactly, and the compression aims `(1 + tolerance)³` higher, so the
+    /// requested fraction is still met. Default 1e-3: the looser the
+    /// tolerance, the fewer iterations to reach it but the nearer to jamming
+    /// the aim; 10⁴ spheres to 0.64 over 6 seeds: 20,711 FIRE iterations at
+    /// 1e-4, 16,836 at 4e-4, 15,501 at 1e-3, 20,026 at 2e-3. For
+    /// [`Target::Jammed`] the final expansion gives up at most that relative
+    /// size of the jamming point (3 · tolerance in φ).
     pub tolerance: f64,
 }
 
@@ -159,7 +167,7 @@ impl Default for DensifyParams {
             max_step: 0.1,
             min_step: 2e-4,
             max_iterations: 20_000,
-            tolerance: 1e-4,
+            tolerance: 1e-3,
         }
     }
 }
@@ -224,7 +232,8 @@ pub struct DensifyStats {
     pub iterations: usize,
     /// Neighbour-list builds.
     pub neighbour_builds: usize,
-    /// Largest overlap left, as a fraction of `d_min` (≤ the tolerance).
+    /// Largest overlap of the result (after the final expansion), as a
+    /// fraction of the pair's smaller diameter: 0 up to round-off.
     pub max_overlap: f64,
 }
 
@@ -304,9 +313,10 @@ pub fn densify(
     }
     sys.expand_free();
     let phi_in = solid / sys.geom.volume();
-    // the final expansion gives up at most (1 + 2 tolerance)³ (a wall's clearance may be as
-    // small as r_min = d_min / 2); aim that much higher
-    let headroom = (1.0 + 2.0 * params.tolerance).powi(3);
+    // the relaxation leaves every overlap at most the tolerance times the pair's centre
+    // distance (a wall's: times the sphere's clearance), so the final expansion, by one plus
+    // the largest of those ratios, gives up at most (1 + tolerance)³; aim that much higher
+    let headroom = (1.0 + params.tolerance).powi(3);
     let goal = match params.target {
         Target::Fraction(f) => {
             if f < phi_in - 1e-12 {

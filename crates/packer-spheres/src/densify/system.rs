@@ -92,7 +92,7 @@ impl System {
             ids: (0..n as u32).collect(),
             skin: 0.25 * d_min,
             r_max,
-            tol: tolerance * d_min,
+            tol: tolerance,
             built: false,
         }
     }
@@ -340,7 +340,12 @@ impl System {
                     } else {
                         ([0.0; 3], f64::NEG_INFINITY)
                     };
-                    let mut worst = ow;
+                    // a wall's overlap over the sphere's clearance (r − overlap)
+                    let mut worst = if ow > 0.0 {
+                        ow / (a[3] - ow).max(1e-12)
+                    } else {
+                        0.0
+                    };
                     let (e0, e1) = (start[i] as usize, start[i + 1] as usize);
                     // branch-free, two pairs at a time (the square roots and divisions of
                     // the two pairs go through the vector units together): half of the
@@ -375,13 +380,13 @@ impl System {
                         // coincident centres (a broken input) get no force, not a NaN
                         let dist = [dd[0].sqrt().max(1e-12), dd[1].sqrt().max(1e-12)];
                         let ov = [a[3] + b0[3] - dist[0], a[3] + b1[3] - dist[1]];
-                        for l in 0..2 {
-                            worst2[l] = if ov[l] > worst2[l] { ov[l] } else { worst2[l] };
-                        }
                         let k = [
                             (if ov[0] > 0.0 { ov[0] } else { 0.0 }) / dist[0],
                             (if ov[1] > 0.0 { ov[1] } else { 0.0 }) / dist[1],
                         ];
+                        for l in 0..2 {
+                            worst2[l] = if k[l] > worst2[l] { k[l] } else { worst2[l] };
+                        }
                         let g0 = [k[0] * d0[0], k[0] * d0[1], k[0] * d0[2]];
                         let g1 = [k[1] * d1[0], k[1] * d1[1], k[1] * d1[2]];
                         for c in 0..3 {
@@ -403,8 +408,8 @@ impl System {
                         ];
                         let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-12);
                         let ov = a[3] + b[3] - dist;
-                        worst2[0] = if ov > worst2[0] { ov } else { worst2[0] };
                         let k = (if ov > 0.0 { ov } else { 0.0 }) / dist;
+                        worst2[0] = if k > worst2[0] { k } else { worst2[0] };
                         let g = [k * d[0], k * d[1], k * d[2]];
                         for c in 0..3 {
                             acc2[c][0] += g[c];
@@ -560,7 +565,7 @@ impl System {
         let mut n = 0;
         for i in 0..self.xr.len() {
             let a = self.xr[i];
-            if self.geom.wall(&a, a[3]).1 > self.tol {
+            if self.geom.wall_ratio(&a, a[3]) > self.tol {
                 n += 1;
             }
             for &j in &self.list[self.start[i] as usize..self.start[i + 1] as usize] {
@@ -569,7 +574,7 @@ impl System {
                     let b = &self.xr[j];
                     let d = Self::delta(&periods, &a, b);
                     let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                    if a[3] + b[3] - dist > self.tol {
+                    if (a[3] + b[3] - dist) / dist > self.tol {
                         n += 1;
                     }
                 }
