@@ -102,7 +102,7 @@ pub(crate) struct Pack {
     #[arg(long)]
     container: Option<String>,
     /// 3D only: after the front, densify (affine compression with FIRE
-    /// overlap relaxation, `packer-quadtree::densify`) to this solid fraction
+    /// overlap relaxation, `packer-spheres::densify`) to this solid fraction
     /// of the container, in (0, 0.74], or to `jammed` (the container shrinks
     /// to the jamming point). Also allows `box:LX,LY,LZ,periodic-xyz`.
     #[arg(long)]

@@ -3,8 +3,9 @@
 //! φ = 0.64 (`pack3d_dense`, what the validate case runs), and the densify
 //! stage alone from the front's packing of a cube (x/y periodic, z walls,
 //! treated as periodic) to 0.63 and 0.64. The peer, packing-generation
-//! (force-biased then Lubachevsky–Stillinger, one core), takes 68–90 s for
-//! 10⁴ spheres to φ 0.644 on the 2-core machine.
+//! (force-biased then Lubachevsky–Stillinger, one core), takes 63–97 s for
+//! 10⁴ spheres to φ 0.644 on the 2-core machine (its speed varies by up to
+//! 2× within an hour: compare with the peer in the same minutes).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Point3;

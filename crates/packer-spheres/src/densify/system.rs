@@ -583,3 +583,126 @@ impl System {
         n
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The half list's forces against a brute-force sum over all pairs (minimum image).
+
+    use nalgebra::Point3;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::super::{Boundary, DensifyStats};
+    use super::{Geom, System};
+    use crate::{Container, Sphere};
+
+    /// Random spheres (r in [0.5, 1]) crowded into `boundary` so that many overlap.
+    fn crowd(n: usize, lo: f64, hi: f64, seed: u64) -> Vec<Sphere> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| Sphere {
+                center: Point3::new(
+                    rng.random_range(lo..hi),
+                    rng.random_range(lo..hi),
+                    rng.random_range(lo..hi),
+                ),
+                radius: rng.random_range(0.5..1.0),
+            })
+            .collect()
+    }
+
+    /// Brute force: `Σ_j (r_i + r_j − d)₊ d̂` over every other sphere's nearest image plus
+    /// the walls' force, and the largest overlap over centre distance.
+    fn brute(sys: &System) -> (Vec<[f64; 3]>, f64) {
+        let periods = sys.geom.periods();
+        let mut worst = 0.0_f64;
+        let f = (0..sys.xr.len())
+            .map(|i| {
+                let a = sys.xr[i];
+                let (mut acc, ow) = if sys.geom.has_walls() {
+                    sys.geom.wall(&a, a[3])
+                } else {
+                    ([0.0; 3], f64::NEG_INFINITY)
+                };
+                if ow > 0.0 {
+                    worst = worst.max(ow / (a[3] - ow));
+                }
+                for (j, b) in sys.xr.iter().enumerate() {
+                    if j == i {
+                        continue;
+                    }
+                    let mut d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                    for k in 0..3 {
+                        if periods[k] > 0.0 {
+                            d[k] -= periods[k] * (d[k] / periods[k]).round();
+                        }
+                    }
+                    let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    let ov = a[3] + b[3] - dist;
+                    if ov > 0.0 {
+                        worst = worst.max(ov / dist);
+                        for k in 0..3 {
+                            acc[k] += ov / dist * d[k];
+                        }
+                    }
+                }
+                acc
+            })
+            .collect();
+        (f, worst)
+    }
+
+    fn check(boundary: &Boundary, spheres: &[Sphere]) {
+        let geom = Geom::new(boundary).expect("geometry");
+        let mut sys = System::new(spheres, geom, 0.5, 1.0, 1e-3);
+        // a few FIRE steps move the centres off their build positions (and wrap none)
+        let mut stats = DensifyStats::default();
+        sys.relax(5, &mut stats);
+        sys.build();
+        let s = sys.forces();
+        let (f, worst) = brute(&sys);
+        assert!(worst > 0.05, "the test must have overlaps: {worst}");
+        assert!((s.worst - worst).abs() <= 1e-12, "{} vs {worst}", s.worst);
+        let scale = f
+            .iter()
+            .map(|g| g[0].abs() + g[1].abs() + g[2].abs())
+            .fold(0.0, f64::max);
+        for (i, (a, b)) in sys.f.iter().zip(&f).enumerate() {
+            for k in 0..3 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-12 * scale,
+                    "sphere {i}: {a:?} vs {b:?}"
+                );
+            }
+        }
+        // Newton's third law: the forces sum to the walls' share (zero when fully periodic)
+        if !sys.geom.has_walls() {
+            for k in 0..3 {
+                let total: f64 = sys.f.iter().map(|g| g[k]).sum();
+                assert!(total.abs() <= 1e-10 * scale, "net force {total}");
+            }
+        }
+    }
+
+    #[test]
+    fn half_list_forces_match_the_brute_force_sum() {
+        let l = 9.0;
+        let periodic = Boundary::Periodic {
+            min: Point3::origin(),
+            max: Point3::new(l, l, l),
+        };
+        check(&periodic, &crowd(150, 0.0, l, 1));
+        let walled = Boundary::Walls(Container::Box {
+            min: Point3::origin(),
+            max: Point3::new(l, l, l),
+            periodic: [true, false],
+        });
+        check(&walled, &crowd(150, 0.5, l - 0.5, 2));
+        let cylinder = Boundary::Walls(Container::Cylinder {
+            base: Point3::new(4.5, 4.5, 0.0),
+            radius: 4.5,
+            height: l,
+        });
+        check(&cylinder, &crowd(100, 2.0, 7.0, 3));
+    }
+}
