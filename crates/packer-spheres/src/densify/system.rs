@@ -47,7 +47,8 @@ pub(super) struct System {
     pub(super) ids: Vec<u32>,
     skin: f64,
     r_max: f64,
-    /// Overlap accepted by the relaxation (absolute).
+    /// Overlap accepted by the relaxation, over the pair's centre distance (a wall's:
+    /// over the sphere's clearance).
     tol: f64,
     built: bool,
 }
@@ -269,15 +270,26 @@ impl System {
                 out
             })
             .collect();
+        self.set_lists(&upper);
+        self.x_build.clear();
+        self.x_build
+            .extend(self.xr.iter().map(|p| [p[0], p[1], p[2]]));
+        self.built = true;
+    }
+
+    /// The lists from each sphere's pairs with higher-numbered ones: `start`/`list`, the
+    /// entries of each sphere as the higher one (`lstart`/`lref`), and room for the pair
+    /// forces.
+    fn set_lists(&mut self, upper: &[Vec<u32>]) {
         self.start.clear();
         self.list.clear();
         self.start.push(0);
-        for u in &upper {
+        for u in upper {
             self.list.extend_from_slice(u);
             self.start.push(self.list.len() as u32);
         }
         // each sphere's entries as the higher-numbered sphere, in entry order
-        let n = xr.len();
+        let n = self.xr.len();
         let mut count = vec![0u32; n + 1];
         for &e in &self.list {
             count[(e & INDEX_MASK) as usize + 1] += 1;
@@ -296,10 +308,6 @@ impl System {
         self.lstart = count;
         self.pf.clear();
         self.pf.resize(self.list.len(), [0.0; 3]);
-        self.x_build.clear();
-        self.x_build
-            .extend(self.xr.iter().map(|p| [p[0], p[1], p[2]]));
-        self.built = true;
     }
 
     /// Forces into `self.f`, with the chunk sums of `F·v`, `|F|²`, `|v|²` and the largest
@@ -308,6 +316,16 @@ impl System {
     /// opposite of the stored forces of the pairs in which it is the higher sphere, in a
     /// fixed order; so every sum is the same for any thread count.
     fn forces(&mut self) -> Sums {
+        let worst = self.pair_pass();
+        Sums {
+            worst,
+            ..self.completing_pass()
+        }
+    }
+
+    /// The pair pass of [`System::forces`]: each sphere's wall force and its listed pairs'
+    /// forces into `self.f`, the pairs' stored in `self.pf`; the largest overlap ratio.
+    fn pair_pass(&mut self) -> f64 {
         let shifts = image_shifts(&self.geom.periods());
         let geom = self.geom;
         let walled = geom.has_walls();
@@ -324,8 +342,7 @@ impl System {
             rest = tail;
             at = end;
         }
-        let worst = self
-            .f
+        self.f
             .par_chunks_mut(CHUNK)
             .zip(pf_parts.into_par_iter())
             .enumerate()
@@ -425,7 +442,13 @@ impl System {
                 }
                 chunk_worst
             })
-            .reduce(|| f64::NEG_INFINITY, f64::max);
+            .reduce(|| f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The completing pass of [`System::forces`]: each sphere takes the opposite of the
+    /// stored forces of the pairs it is the higher sphere of, in entry order; the chunk sums
+    /// of `F·v`, `|F|²` and `|v|²` in chunk order.
+    fn completing_pass(&mut self) -> Sums {
         let (v, pf, lstart, lref) = (&self.v, &self.pf, &self.lstart, &self.lref);
         let parts: Vec<Sums> = self
             .f
@@ -460,7 +483,7 @@ impl System {
             power: 0.0,
             ff: 0.0,
             vv: 0.0,
-            worst,
+            worst: f64::NEG_INFINITY,
         };
         for p in &parts {
             t.power += p.power;
