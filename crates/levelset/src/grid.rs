@@ -355,7 +355,9 @@ impl Grid {
             .then(|| self.cell_trilinear(cell, t))
     }
 
-    #[inline]
+    // always inlined: `Grid::value` is the measurement's innermost call, and as a call this
+    // costs the DNA of the 512³ scan 18 % (7.1–7.6 s → 8.5–8.8 s, alternating builds)
+    #[inline(always)]
     fn cell_trilinear(&self, [i, j, k]: [usize; 3], [tx, ty, tz]: [f64; 3]) -> f64 {
         let nx = self.spec.dims[0];
         let sy = nx;
