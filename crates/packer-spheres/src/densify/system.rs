@@ -53,7 +53,7 @@ pub(super) struct System {
     built: bool,
 }
 
-/// Partial sums of one chunk of the force pass.
+/// The sums of the force pass.
 #[derive(Clone, Copy)]
 struct Sums {
     power: f64,
@@ -317,9 +317,12 @@ impl System {
     /// fixed order; so every sum is the same for any thread count.
     fn forces(&mut self) -> Sums {
         let worst = self.pair_pass();
+        let [power, ff, vv] = self.completing_pass();
         Sums {
+            power,
+            ff,
+            vv,
             worst,
-            ..self.completing_pass()
         }
     }
 
@@ -448,19 +451,15 @@ impl System {
     /// The completing pass of [`System::forces`]: each sphere takes the opposite of the
     /// stored forces of the pairs it is the higher sphere of, in entry order; the chunk sums
     /// of `F·v`, `|F|²` and `|v|²` in chunk order.
-    fn completing_pass(&mut self) -> Sums {
+    fn completing_pass(&mut self) -> [f64; 3] {
         let (v, pf, lstart, lref) = (&self.v, &self.pf, &self.lstart, &self.lref);
-        let parts: Vec<Sums> = self
+        let parts: Vec<[f64; 3]> = self
             .f
             .par_chunks_mut(CHUNK)
             .enumerate()
             .map(|(c, fs)| {
-                let mut s = Sums {
-                    power: 0.0,
-                    ff: 0.0,
-                    vv: 0.0,
-                    worst: f64::NEG_INFINITY,
-                };
+                // F·v, |F|², |v|²
+                let mut s = [0.0; 3];
                 for (o, f) in fs.iter_mut().enumerate() {
                     let i = c * CHUNK + o;
                     let mut acc = *f;
@@ -472,23 +471,18 @@ impl System {
                     }
                     *f = acc;
                     let w = &v[i];
-                    s.power += acc[0] * w[0] + acc[1] * w[1] + acc[2] * w[2];
-                    s.ff += acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
-                    s.vv += w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+                    s[0] += acc[0] * w[0] + acc[1] * w[1] + acc[2] * w[2];
+                    s[1] += acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+                    s[2] += w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
                 }
                 s
             })
             .collect();
-        let mut t = Sums {
-            power: 0.0,
-            ff: 0.0,
-            vv: 0.0,
-            worst: f64::NEG_INFINITY,
-        };
+        let mut t = [0.0; 3];
         for p in &parts {
-            t.power += p.power;
-            t.ff += p.ff;
-            t.vv += p.vv;
+            for (t, p) in t.iter_mut().zip(p) {
+                *t += p;
+            }
         }
         t
     }
@@ -591,15 +585,13 @@ impl System {
             if self.geom.wall_ratio(&a, a[3]) > self.tol {
                 n += 1;
             }
+            // each pair is listed once, from its lower sphere
             for &j in &self.list[self.start[i] as usize..self.start[i + 1] as usize] {
-                let j = (j & INDEX_MASK) as usize;
-                if j > i {
-                    let b = &self.xr[j];
-                    let d = Self::delta(&periods, &a, b);
-                    let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                    if (a[3] + b[3] - dist) / dist > self.tol {
-                        n += 1;
-                    }
+                let b = &self.xr[(j & INDEX_MASK) as usize];
+                let d = Self::delta(&periods, &a, b);
+                let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                if (a[3] + b[3] - dist) / dist > self.tol {
+                    n += 1;
                 }
             }
         }
