@@ -37,7 +37,7 @@ pub(crate) fn cases() -> Vec<Case> {
 }
 
 /// Why the analytic grains miss the closed forms (our finding, issue 31).
-const REASON: &str = "issue 31, not met (our finding): with σ = 0.7 (the blur under which the clones' round trip is unbiased) the voxel staircase leaves curvature noise that the corner rule (κ₁ > 1/r_ins) counts on the gently curved parts, so every shape reads 0.35-0.48 (a pull toward one value); exact surfaces on the canonical 45³ grid read 0.335-0.377 for ρ/a = 0.3 (ρ is 4 cells: the grid's floor), 0.51-0.52 for ρ/a = 0.5, 0.665-0.68 for p = 3 (0.664) and 0.527-0.567 for p = 4 (0.526); a σ = 2 blur with a σ²H/2 curvature de-bias reaches 0.35 / 0.52 / 0.63 / 0.52 at 60 voxels but biases the clones' round trip by +21 %";
+const REASON: &str = "issue 31, not met (our finding): with σ = 0.7 (the blur under which the clones' round trip is unbiased) the voxel staircase leaves curvature noise that the corner rule (κ₁ > 1/r_ins) counts on the gently curved parts, so every shape reads 0.35-0.48 (a pull toward one value); exact surfaces on the canonical 45³ grid read 0.335-0.377 for ρ/a = 0.3 (ρ is 4 cells: the grid's floor), 0.51-0.52 for ρ/a = 0.5, 0.665-0.68 for p = 3 (0.664) and 0.527-0.567 for p = 4 (0.526); a σ = 2 blur with a σ²H/2 curvature de-bias reaches 0.35 / 0.52 / 0.63 / 0.52 at 60 voxels but biases the clones' round trip by +21 %; the plain voxel surface fitted in the clones' 28 × 18 Catmull-Rom representation (branch radial-fit-roundness) reads ρ/a = 0.5 within 3 % at 30 and 60 voxels and p = 4 within 1 % at 60, but ρ/a = 0.3 +22 % (the mesh cannot carry it) and p = 3 -19 % / p = 4 -6 % at 30 (node staircase read as corners)";
 
 pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
     ExpectedFailure {
