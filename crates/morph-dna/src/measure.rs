@@ -52,7 +52,10 @@
 //!   round trip at 30 voxels per diameter reads 7.0 % mean, 38.6 % worst, +0.6 % bias
 //!   (σ = 1 on the crop, before: 14 %, 68 %, +7.6 %), but ranks the clones weakly
 //!   (Spearman 0.53)
-//!   and voxelised analytic grains all read 0.35–0.48; see the validate cases
+//!   and voxelised analytic grains all read 0.35–0.48 (a voxelised sphere, roundness 1:
+//!   0.42–0.51 at 16–90 voxels across — the staircase's high-curvature points pass the
+//!   corner rule, so the clones' mean bias is small only because their roundness, 0.38–0.59,
+//!   sits near that floor); see the validate cases
 //!   `parents/roundtrip-npy` and `levelset/voxel-roundness` for the measurements.
 //! * **Principal frame signs** (eigenvectors are defined up to sign): the
 //!   major and intermediate axes point to the side where the grain's third
