@@ -145,6 +145,8 @@ pub(crate) struct Loaded {
     pub(crate) levelset_s: f64,
     /// How these grains are measured ([`measure_params`]).
     pub(crate) measure: morph_dna::MeasureParams,
+    /// What the user must know about these grains' roundness (labelled images).
+    pub(crate) roundness_note: Option<String>,
 }
 
 impl Loaded {
@@ -176,6 +178,9 @@ impl Loaded {
                 let _ = write!(s, "{} {n} {r}", if k == 0 { "" } else { ";" });
             }
             s.push('.');
+        }
+        if let Some(n) = &self.roundness_note {
+            let _ = write!(s, " {n}");
         }
         let _ = write!(
             s,
@@ -457,7 +462,6 @@ fn load_image(
             source.display()
         );
     }
-    eprintln!("{}", roundness_note(across));
     let out = Loaded {
         names,
         grids,
@@ -468,6 +472,7 @@ fn load_image(
         read_s,
         levelset_s,
         measure: measure_params(format, args.native_roundness),
+        roundness_note: Some(roundness_note(across)),
     };
     check_count(&out, source)?;
     Ok(out)
@@ -527,6 +532,7 @@ fn load_meshes(
         read_s,
         levelset_s: t1.elapsed().as_secs_f64(),
         measure: morph_dna::MeasureParams::default(),
+        roundness_note: None,
     })
 }
 
@@ -563,6 +569,7 @@ fn load_sh(args: &ParentArgs, files: &[PathBuf]) -> anyhow::Result<Loaded> {
         read_s,
         levelset_s: t1.elapsed().as_secs_f64(),
         measure: morph_dna::MeasureParams::default(),
+        roundness_note: None,
     })
 }
 
@@ -587,6 +594,7 @@ fn load_morph(files: &[PathBuf]) -> anyhow::Result<Loaded> {
         read_s: t0.elapsed().as_secs_f64(),
         levelset_s: 0.0,
         measure: morph_dna::MeasureParams::default(),
+        roundness_note: None,
     })
 }
 
@@ -610,7 +618,7 @@ fn median_voxels_across(counts: impl Iterator<Item = usize>) -> f64 {
 /// the README and the validate cases `parents/roundtrip-npy`, `levelset/voxel-roundness`).
 fn roundness_note(across: f64) -> String {
     format!(
-        "note: these grains' median equivalent diameter is {across:.0} voxels. 3D roundness \
+        "Median equivalent diameter {across:.0} voxels: 3D roundness \
          read from voxels is not yet faithful (issue 31): a voxelised sphere (roundness 1) \
          reads 0.42-0.51 at 16-90 voxels across, so grains rounder than about 0.5 read too \
          angular, and clones at 30 voxels per diameter read 7 % off on average (38 % at \
@@ -874,7 +882,7 @@ mod tests {
         assert!(super::median_voxels_across(std::iter::empty()).is_nan());
         let n = super::roundness_note(d);
         assert!(
-            n.contains("diameter is 37 voxels") && n.contains("issue 31"),
+            n.contains("diameter 37 voxels") && n.contains("issue 31"),
             "{n}"
         );
     }
