@@ -3,6 +3,8 @@
 //! `morph_dna::MeasureParams::voxel_images`), against closed-form values, not against the
 //! pipeline at high resolution.
 //!
+//! * **Sphere** of radius `a`: κ₁ = 1/a = 1/r_ins everywhere, no corner, roundness **1**
+//!   (the limit of both families below); it shows the floor of the voxel reading.
 //! * **Rounded cube** of half-side `a` whose edges and corners are rounded with radius ρ
 //!   (the Minkowski sum of a cube of half-side a − ρ and a ball of radius ρ): faces are
 //!   flat, edges are cylinders and corners spheres of radius ρ, so every corner point has
@@ -29,7 +31,7 @@ use crate::{Case, Check, Error, ExpectedFailure, Tolerance};
 pub(crate) fn cases() -> Vec<Case> {
     vec![Case {
         name: "levelset/voxel-roundness",
-        description: "rounded cubes (ρ/a = 0.3, 0.5) and superballs (p = 3, 4) voxelised at 20, 30 and 60 voxels across (rotated, off-lattice), extracted and measured as the image path does: roundness within 5 % of the closed form at 30 and 60 voxels (reported at 20, within 10 %)",
+        description: "a sphere, rounded cubes (ρ/a = 0.3, 0.5) and superballs (p = 3, 4) voxelised at 20, 30 and 60 voxels across (rotated, off-lattice), extracted and measured as the image path does: roundness within 5 % of the closed form at 30 and 60 voxels (reported at 20, within 10 %)",
         fast: false,
         heavy: false,
         run: voxel_roundness,
@@ -39,7 +41,25 @@ pub(crate) fn cases() -> Vec<Case> {
 /// Why the analytic grains miss the closed forms (our finding, issue 31).
 const REASON: &str = "issue 31, not met (our finding): with σ = 0.7 (the blur under which the clones' round trip is unbiased) the voxel staircase leaves curvature noise that the corner rule (κ₁ > 1/r_ins) counts on the gently curved parts, so every shape reads 0.35-0.48 (a pull toward one value); exact surfaces on the canonical 45³ grid read 0.335-0.377 for ρ/a = 0.3 (ρ is 4 cells: the grid's floor), 0.51-0.52 for ρ/a = 0.5, 0.665-0.68 for p = 3 (0.664) and 0.527-0.567 for p = 4 (0.526); a σ = 2 blur with a σ²H/2 curvature de-bias reaches 0.35 / 0.52 / 0.63 / 0.52 at 60 voxels but biases the clones' round trip by +21 %; the plain voxel surface fitted in the clones' 28 × 18 Catmull-Rom representation (branch radial-fit-roundness) reads ρ/a = 0.5 within 3 % at 30 and 60 voxels and p = 4 within 1 % at 60, but ρ/a = 0.3 +22 % (the mesh cannot carry it) and p = 3 -19 % / p = 4 -6 % at 30 (node staircase read as corners); even a voxelised sphere (roundness 1) of radius 8 / 12 / 20 voxels reads 0.48 / 0.45 / 0.42 through the image path";
 
+/// Why even the sphere misses (our finding, issue 31).
+const SPHERE_REASON: &str = "issue 31, not met (our finding): the floor of the voxel roundness; the corner rule's threshold κ₁ > 1/r_ins is a sphere's own curvature, so on a voxelised sphere the staircase's curvature noise (local curvature estimators of digitised surfaces converge only as h^(1/3), Coeurjolly, Lachaud & Levallois 2014: ≈ 40 % at a 15-voxel radius) sorts points into corners; it reads 0.42-0.51 at 16-90 voxels across through the image path, 0.17-0.58 on the native grid; a σ = 1.5 blur lifts it to 0.82 at 30 voxels but biases the clones' round trip by +27 %";
+
 pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "sphere at 20 voxels across",
+        reason: SPHERE_REASON,
+    },
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "sphere at 30 voxels across",
+        reason: SPHERE_REASON,
+    },
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "sphere at 60 voxels across",
+        reason: SPHERE_REASON,
+    },
     ExpectedFailure {
         case: "levelset/voxel-roundness",
         metric: "rounded cube ρ/a = 0.3 at 20 voxels across",
@@ -111,6 +131,9 @@ fn err(e: impl std::fmt::Display) -> Error {
 /// An analytic grain: inside test in its own frame, and its closed-form roundness.
 #[derive(Debug, Clone, Copy)]
 enum Shape {
+    /// The unit ball: no point is sharper than the inscribed sphere, roundness 1 (the
+    /// limit of both families, ρ/a = 1 and p = 2).
+    Sphere,
     /// Half-side `a` = 1, corner radius ρ.
     RoundedCube { rho: f64 },
     /// `|x|ᵖ + |y|ᵖ + |z|ᵖ = 1`.
@@ -120,6 +143,7 @@ enum Shape {
 impl Shape {
     fn inside(self, q: &Vector3<f64>) -> bool {
         match self {
+            Self::Sphere => q.norm() < 1.0,
             Self::RoundedCube { rho } => {
                 let d = q.abs() - Vector3::repeat(1.0 - rho);
                 let outside = d.sup(&Vector3::zeros()).norm();
@@ -131,6 +155,7 @@ impl Shape {
 
     fn reference(self) -> f64 {
         match self {
+            Self::Sphere => 1.0,
             Self::RoundedCube { rho } => rho,
             Self::Superball { p } => superball_roundness(p, 800),
         }
@@ -138,6 +163,7 @@ impl Shape {
 
     fn name(self) -> String {
         match self {
+            Self::Sphere => "sphere".to_owned(),
             Self::RoundedCube { rho } => format!("rounded cube ρ/a = {rho}"),
             Self::Superball { p } => format!("superball p = {p}"),
         }
@@ -222,6 +248,7 @@ fn voxelise(shape: Shape, across: f64) -> Result<LabelImage, Error> {
 
 fn voxel_roundness() -> Result<Vec<Check>, Error> {
     let shapes = [
+        Shape::Sphere,
         Shape::RoundedCube { rho: 0.3 },
         Shape::RoundedCube { rho: 0.5 },
         Shape::Superball { p: 3.0 },
