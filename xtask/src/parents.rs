@@ -598,11 +598,6 @@ fn load_morph(files: &[PathBuf]) -> anyhow::Result<Loaded> {
     })
 }
 
-/// The measurement of grains read in `format`: labelled images measure their roundness
-/// on the canonical grid (`morph_dna::MeasureParams::voxel_images`), the same relative
-/// resolution as the mesh, SH and LS-DEM parents built at `--resolution` and as the
-/// clones; every other format keeps the defaults.
-/// (`--native-roundness` keeps the scan's own grid).
 /// The median equivalent diameter, in voxels, of grains of these voxel counts.
 fn median_voxels_across(counts: impl Iterator<Item = usize>) -> f64 {
     let mut v: Vec<usize> = counts.collect();
@@ -626,6 +621,11 @@ fn roundness_note(across: f64) -> String {
     )
 }
 
+/// The measurement of grains read in `format`: labelled images measure their roundness
+/// on the canonical grid (`morph_dna::MeasureParams::voxel_images`), the same relative
+/// resolution as the mesh, SH and LS-DEM parents built at `--resolution` and as the
+/// clones; every other format keeps the defaults.
+/// (`--native-roundness` keeps the scan's own grid).
 pub(crate) fn measure_params(format: InputFormat, native: bool) -> morph_dna::MeasureParams {
     match format {
         InputFormat::Npy | InputFormat::Tiff | InputFormat::Raw if !native => {
@@ -653,7 +653,6 @@ pub(crate) fn measure(loaded: Loaded) -> anyhow::Result<(cloner::Parents, Vec<St
 
 #[cfg(test)]
 mod tests {
-
     //! Bad input through the file path: every error names the file (and
     //! what the parser located), nothing is half-written.
 
