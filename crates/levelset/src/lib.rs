@@ -115,8 +115,8 @@ pub use contact::{Body, NodeContact, contact, contact_into};
 pub use error::{Error, Result};
 pub use grid::{Grid, GridSpec};
 pub use labels::{
-    ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, LabelImage, ROUNDNESS_SMOOTHING,
-    SkipCounts, SkipReason, Skipped,
+    Bending, ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, LabelImage,
+    ROUNDNESS_SMOOTHING, SkipCounts, SkipReason, Skipped,
 };
 pub use mesh::{FAR_ERROR_CELLS, MESH_BAND_CELLS, MeshDistance, MeshRepair, Orientation, TriMesh};
 pub use properties::{MassProperties, Principal};

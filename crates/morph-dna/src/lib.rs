@@ -111,9 +111,10 @@ pub use grading::{GradingCoefficients, GradingCurve, GradingInterpolation, Gradi
 pub use histogram::{BinAxis, Histogram1d, Histogram2d};
 pub use hull::{convex_hull, convex_hull_volume};
 pub use measure::{
-    CANONICAL_MARGIN, CANONICAL_RESOLUTION, CornerAveraging, MeasureParams, Measurement,
-    PrincipalFrame, RoundnessGrid, max_principal_curvature, measure, measure_star, measure_table,
-    measure_with_frame, principal_frame, radial_profile,
+    BENDING_CORNER_OFFSET, CANONICAL_MARGIN, CANONICAL_RESOLUTION, CornerAveraging,
+    MAX_CORNER_RADIUS_OFFSET, MeasureParams, Measurement, PrincipalFrame, RoundnessGrid,
+    max_principal_curvature, measure, measure_star, measure_table, measure_with_frame,
+    principal_frame, radial_profile,
 };
 pub use pdf::{Bandwidth, BicubicPdf, GaussianKde2d, TabulatedPdf2d};
 pub use radial::{

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use super::LabelImage;
+use super::bending::{self, Bending};
 use crate::error::{Error, Result};
 use crate::grid::{Grid, GridSpec};
 
@@ -38,6 +39,11 @@ pub struct ExtractParams {
     /// grains ≥ 6 voxels across at 2.5 times the cost; see the module doc for the
     /// measurement.
     pub smoothing: Option<f64>,
+    /// Minimal-bending refinement of the interface after the EDT or the blur (`None`: none,
+    /// the default). It keeps every voxel centre on its side and removes the staircase:
+    /// a voxelised sphere's 3D roundness reads 0.84-0.91 instead of 0.44-0.47 (module docs
+    /// of [`crate::labels`]); [`ExtractParams::minimal_bending`] selects it.
+    pub bending: Option<Bending>,
     /// Extract grains in parallel with rayon (results are identical either way).
     /// Default `true`.
     pub parallel: bool,
@@ -51,6 +57,7 @@ impl Default for ExtractParams {
             components: ComponentPolicy::KeepLargest,
             pad: 2,
             smoothing: Some(1.0),
+            bending: None,
             parallel: true,
         }
     }
@@ -72,6 +79,19 @@ impl ExtractParams {
             ..Self::default()
         }
     }
+
+    /// [`ExtractParams::voxel_images`] with the minimal-bending refinement
+    /// ([`Bending::default`]) and a pad of 5 voxels (the band of 3 voxels plus the
+    /// stencil's 2 fixed nodes), for smooth, staircase-free surfaces whose curvature can be
+    /// measured: see the module docs of [`crate::labels`] for what it reads on analytic
+    /// grains and on cloned grains, and its cost.
+    pub fn minimal_bending() -> Self {
+        Self {
+            bending: Some(Bending::default()),
+            pad: 5,
+            ..Self::voxel_images()
+        }
+    }
 }
 
 /// Largest Gaussian σ accepted, in voxels (a wider blur erases grains of a few voxels and
@@ -83,7 +103,8 @@ impl ExtractParams {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for `min_voxels` = 0, `pad` = 0, `pad` > 1000, or a
-    /// smoothing σ that is not finite, ≤ 0 or > [`MAX_SMOOTHING`].
+    /// smoothing σ that is not finite, ≤ 0 or > [`MAX_SMOOTHING`], and those of
+    /// [`Bending::validate`].
     pub fn validate(&self) -> Result<()> {
         if self.min_voxels == 0 {
             return Err(Error::InvalidParameter {
@@ -107,6 +128,9 @@ impl ExtractParams {
                 value: s,
                 requirement: "finite, > 0 and ≤ 8 voxels",
             });
+        }
+        if let Some(b) = &self.bending {
+            b.validate()?;
         }
         Ok(())
     }
@@ -444,11 +468,10 @@ fn extract_one(img: &LabelImage, label: u32, st: &Stats, p: &ExtractParams) -> R
         origin: img.origin + img.spacing * first,
         spacing: img.spacing,
     };
-    let grid = match p.smoothing {
+    let mut grid = match p.smoothing {
         None => Grid::from_voxels(spec, &mask)?,
         Some(sigma) => {
             let mut grey: Vec<f64> = mask.iter().map(|&b| f64::from(u8::from(b))).collect();
-            drop(mask);
             gaussian_blur(&mut grey, cdims, sigma);
             let mut g = match Grid::from_grayscale(spec, &grey, 0.5) {
                 Ok(g) => g,
@@ -471,6 +494,14 @@ fn extract_one(img: &LabelImage, label: u32, st: &Stats, p: &ExtractParams) -> R
             g
         }
     };
+    if let Some(b) = &p.bending {
+        bending::refine(grid.values_mut(), &mask, cdims, img.spacing, b);
+        match grid.reinitialise() {
+            Ok(()) => {}
+            Err(Error::NoSurface) => return skip(voxels, SkipReason::NoSurface),
+            Err(e) => return Err(e),
+        }
+    }
     Ok(Outcome::Grain(ExtractedGrain {
         label,
         grid,

@@ -90,8 +90,10 @@
 //! voxel of the voxel surface) well inside the grid; the blur is computed with zero outside
 //! the crop, which is background anyway.
 
+mod bending;
 mod extract;
 
+pub use bending::Bending;
 pub use extract::{
     ComponentPolicy, ExtractParams, ExtractedGrain, Extraction, MAX_SMOOTHING, ROUNDNESS_SMOOTHING,
     SkipCounts, SkipReason, Skipped,

@@ -81,6 +81,9 @@ pub(crate) fn cases() -> Vec<Case> {
 /// Why the voxel roundness misses issue 31's targets at 30 voxels per diameter (our finding).
 const VOXEL_ROUNDNESS_REASON: &str = "issue 31, not met (our finding): the clones' own roundness is the corner rule read at their 45³ grid's scale, and even their exact surface re-gridded onto another 45³ cube (the canonical grid) reproduces it only to 2.6 % mean / 8.1 % worst, Spearman 0.947, slope 0.905 (at the voxel spacing: 5.9 % / 31.6 %, Spearman 0.73); a 30-voxel image quantises the corners (radii of 3-6 voxels) to ±h/2, and no reconstruction tried keeps both the corners and no staircase curvature: σ = 0.7 + canonical grid (the image path) 7.0 % / 38.6 %, Spearman 0.53, slope 0.34, bias +0.6 % on the clones of the issue-30 calibration (6.1 % / 35 %, 0.56, 0.38 on the previous calibration's clones; with the canonical grid reinitialised by fast sweeping 5.6 % / 31 %, 0.59, 0.42, at 6-7 ms more per grain; today's σ = 1 on the crop: 14 % / 68 %, 0.12, 0.03); σ = 1 / 1.5 + canonical +13 % / +24 % bias; constrained (sign-preserving) smoothing Spearman ≤ 0.75 with ±10 % bias; SH fits of degree 16-32 of the voxel surface Spearman ≤ 0.76 with +7-17 % bias; blur with a σ²H/2 curvature de-bias +21 % at σ = 2; the plain voxel surface fitted in the clones' own representation (28 × 18 Catmull-Rom radii, branch radial-fit-roundness) 4.9 % / 16 %, Spearman 0.83, slope 0.72, but each node keeps ±0.4 voxel of staircase that smooth grains read as corners (an ellipsoid reading 0.82 on its own level set reads 0.57 at 30 voxels), unbiased on the clones only by cancellation; the floor of every reconstruction: a voxelised sphere (roundness 1) of radius 8 / 12 / 20 voxels reads 0.48 / 0.45 / 0.42 through the image path, and the clones' own roundness (0.38-0.59, mean 0.50) sits near it, so the mean bias is small by coincidence (σ = 1 / 1.5 lift that sphere to 0.65 / 0.82 at 30 voxels but bias the clones +15 / +27 %; corner margins 0.25-1 lower every reading)";
 
+/// Why the minimal-bending extraction misses issue 31's round-trip targets (our finding).
+const BENDING_ROUNDTRIP_REASON: &str = "issue 31, not met (our finding): the minimal-bending surface (Lempitsky 2010: the least-bending level set that keeps every voxel centre on its side) with the calibrated corner correction (morph_dna::BENDING_CORNER_OFFSET) reads analytic grains within 4.1 % (levelset/voxel-roundness: ρ/a = 0.5 and superballs p = 3, 4 at 20-60 voxels across) and ranks the clones better than the image path (30 voxels per diameter: Spearman 0.76, slope 0.73, worst 26 %, against 0.53, 0.34, 39 %; 20 voxels: Spearman 0.70, slope 0.91, bias +0.6 %), but its mean error stays 7.7 % (+5.6 % bias) at 30 and 12 % at 20 voxels (without the correction it reads the clones 24 % rounder): the clones' own roundness counts relief of their 28 × 18 radial mesh (nodes about 3.4 voxels apart at 30 voxels per diameter) below what a voxel image resolves; how little relief matters: their 45³ roundness moves by 2.2 % mean (slope 0.91) under 0.75 % rms noise on their radii (0.11 voxel here) and by 3.7 % (slope 0.85) under 1 %, while radii least-squares fitted to the voxels in the clones' true frame differ from the true radii by 0.21 voxel rms although both keep 98-99 % of the voxel centres on their sides (a logistic fit to the voxel labels started from it: 0.22), so the image does not pin the radii closely enough for a slope of 0.9";
+
 pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
     ExpectedFailure {
         case: "parents/ottawa-representative",
@@ -106,6 +109,46 @@ pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
         case: "parents/roundtrip-npy",
         metric: "roundness slope (voxel on own, least squares) 0.9-1.1",
         reason: VOXEL_ROUNDNESS_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "minimal bending: roundness mean |rel. error| <= 5 %",
+        reason: BENDING_ROUNDTRIP_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "minimal bending: roundness worst |rel. error| <= 20 %",
+        reason: BENDING_ROUNDTRIP_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "minimal bending: roundness mean signed rel. error within 5 % (no bias)",
+        reason: BENDING_ROUNDTRIP_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "minimal bending: roundness Spearman rank correlation with the clones' own >= 0.9",
+        reason: BENDING_ROUNDTRIP_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy",
+        metric: "minimal bending: roundness slope (voxel on own, least squares) 0.9-1.1",
+        reason: BENDING_ROUNDTRIP_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy-20",
+        metric: "minimal bending: roundness mean |rel. error| <= 10 %",
+        reason: BENDING_ROUNDTRIP_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy-20",
+        metric: "minimal bending: roundness worst |rel. error| <= 40 %",
+        reason: BENDING_ROUNDTRIP_REASON,
+    },
+    ExpectedFailure {
+        case: "parents/roundtrip-npy-20",
+        metric: "minimal bending: roundness Spearman rank correlation with the clones' own >= 0.9",
+        reason: BENDING_ROUNDTRIP_REASON,
     },
 ];
 
@@ -456,6 +499,7 @@ fn roundness_checks(
     reread: &[Vec<f64>],
     (mean_max, worst_max): (f64, f64),
     ranking: bool,
+    prefix: &str,
 ) -> Result<(), Error> {
     let k = roundness_column()?;
     let x: Vec<f64> = own.iter().map(|r| r[k]).collect();
@@ -465,32 +509,38 @@ fn roundness_checks(
     let worst = rel.iter().fold(0.0f64, |a, b| a.max(*b));
     let bias = x.iter().zip(&y).map(|(a, b)| (b - a) / a).sum::<f64>() / x.len().max(1) as f64;
     checks.push(Check::new(
-        format!("roundness mean |rel. error| <= {:.0} %", 100.0 * mean_max),
+        format!(
+            "{prefix}roundness mean |rel. error| <= {:.0} %",
+            100.0 * mean_max
+        ),
         mean_max,
         mean,
         Tolerance::AtMost(0.0),
     ));
     checks.push(Check::new(
-        format!("roundness worst |rel. error| <= {:.0} %", 100.0 * worst_max),
+        format!(
+            "{prefix}roundness worst |rel. error| <= {:.0} %",
+            100.0 * worst_max
+        ),
         worst_max,
         worst,
         Tolerance::AtMost(0.0),
     ));
     checks.push(Check::new(
-        "roundness mean signed rel. error within 5 % (no bias)",
+        format!("{prefix}roundness mean signed rel. error within 5 % (no bias)"),
         0.0,
         bias,
         Tolerance::Within(0.05),
     ));
     if ranking {
         checks.push(Check::new(
-            "roundness Spearman rank correlation with the clones' own >= 0.9",
+            format!("{prefix}roundness Spearman rank correlation with the clones' own >= 0.9"),
             0.9,
             spearman(&x, &y),
             Tolerance::AtLeast(0.0),
         ));
         checks.push(Check::new(
-            "roundness slope (voxel on own, least squares) 0.9-1.1",
+            format!("{prefix}roundness slope (voxel on own, least squares) 0.9-1.1"),
             1.0,
             ols_slope(&x, &y),
             Tolerance::Within(0.1),
@@ -564,13 +614,53 @@ fn roundtrip_npy_at(voxels_per_diameter: f64) -> Result<RoundTrip, Error> {
 
 fn roundtrip_npy() -> Result<Vec<Check>, Error> {
     let (mut checks, own, reread) = roundtrip_npy_at(ROUNDTRIP_VOXELS_PER_DIAMETER)?;
-    roundness_checks(&mut checks, &own, &reread, (0.05, 0.20), true)?;
+    roundness_checks(&mut checks, &own, &reread, (0.05, 0.20), true, "")?;
+    let (own, bent) = bending_roundtrip(ROUNDTRIP_VOXELS_PER_DIAMETER)?;
+    roundness_checks(&mut checks, &own, &bent, (0.05, 0.20), true, BENDING)?;
     Ok(checks)
+}
+
+/// DNA rows, one per grain ([`cloner::DNA`] order).
+type DnaRows = Vec<Vec<f64>>;
+
+/// Prefix of the round-trip checks of the minimal-bending extraction
+/// (`levelset::ExtractParams::minimal_bending`), measured beside the image path.
+const BENDING: &str = "minimal bending: ";
+
+/// The clones' own DNA rows and the roundness (in the same column, other columns NaN) of
+/// the same lattice image extracted with `levelset::ExtractParams::minimal_bending` and
+/// measured with `morph_dna::MeasureParams::minimal_bending`.
+fn bending_roundtrip(voxels_per_diameter: f64) -> Result<(DnaRows, DnaRows), Error> {
+    let (grids, own) = roundtrip_clones()?;
+    let d: Vec<f64> = own.iter().map(|r| r[1]).collect();
+    let h = median(&d) / voxels_per_diameter;
+    let image = paint_lattice(grids, h, 3)?;
+    let ex = image
+        .extract(&levelset::ExtractParams::minimal_bending())
+        .map_err(err)?;
+    let k = roundness_column()?;
+    let mut rows_own = Vec::new();
+    let mut rows = Vec::new();
+    for g in &ex.grains {
+        let r = morph_dna::measure(
+            &g.grid,
+            &[Descriptor::Roundness],
+            &MeasureParams::minimal_bending(),
+        )
+        .map_err(err)?[0];
+        let mut row = vec![f64::NAN; cloner::DNA.len()];
+        row[k] = r;
+        rows.push(row);
+        rows_own.push(own[g.label as usize - 1].clone());
+    }
+    Ok((rows_own, rows))
 }
 
 fn roundtrip_npy_20() -> Result<Vec<Check>, Error> {
     let (mut checks, own, reread) = roundtrip_npy_at(20.0)?;
-    roundness_checks(&mut checks, &own, &reread, (0.10, 0.40), false)?;
+    roundness_checks(&mut checks, &own, &reread, (0.10, 0.40), false, "")?;
+    let (own, bent) = bending_roundtrip(20.0)?;
+    roundness_checks(&mut checks, &own, &bent, (0.10, 0.40), true, BENDING)?;
     Ok(checks)
 }
 

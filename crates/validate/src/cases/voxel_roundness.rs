@@ -19,6 +19,8 @@
 //!   `r² / (n·u) sin θ dθ dφ` of a star-shaped surface.
 //!
 //! The grains are rotated and placed off the voxel lattice, so the staircases are generic.
+//! Every grain is measured twice: through the image path, and extracted with
+//! `levelset::ExtractParams::minimal_bending` (checks prefixed "minimal bending: ").
 
 use std::f64::consts::PI;
 
@@ -43,6 +45,12 @@ const REASON: &str = "issue 31, not met (our finding): with σ = 0.7 (the blur u
 
 /// Why even the sphere misses (our finding, issue 31).
 const SPHERE_REASON: &str = "issue 31, not met (our finding): the floor of the voxel roundness; the corner rule's threshold κ₁ > 1/r_ins is a sphere's own curvature, so on a voxelised sphere the staircase's curvature noise (local curvature estimators of digitised surfaces converge only as h^(1/3), Coeurjolly, Lachaud & Levallois 2014: ≈ 40 % at a 15-voxel radius) sorts points into corners; it reads 0.42-0.51 at 16-90 voxels across through the image path, 0.17-0.58 on the native grid; a σ = 1.5 blur lifts it to 0.82 at 30 voxels but biases the clones' round trip by +27 %";
+
+/// Why the minimal-bending extraction still misses the closed forms (our finding, issue 31).
+const BENDING_REASON: &str = "issue 31, not met (our finding): ρ/a = 0.3 is below the canonical 45³ grid's floor (its corner radius is 4 grid cells: exact surfaces on that grid read 0.335-0.377); the minimal-bending surface with the calibrated corner correction (levelset::ExtractParams::minimal_bending, morph_dna::MeasureParams::minimal_bending) reads 0.370 / 0.343 / 0.328 at 20 / 30 / 60 voxels across (without the correction 0.46 / 0.40 / 0.36: the least-bending surface inside the voxel tube widens corners by about 0.8 voxel of radius), while ρ/a = 0.5 and the superballs p = 3, 4 read within 4.1 % at every resolution";
+
+/// Why the minimal-bending extraction still misses the sphere (our finding, issue 31).
+const BENDING_SPHERE_REASON: &str = "issue 31, not met (our finding): the minimal-bending surface lifts the voxelised sphere from 0.44-0.47 (the image path) to 0.84 / 0.91 / 0.88 at 20 / 30 / 60 voxels across, 0.79 / 0.88 / 0.87 with the corner correction (which makes every point of a sphere a candidate corner); the rest is curvature that survives where the surface touches the voxel centres: more iterations change nothing (50 and 1000 read the same) and a wider band (6 voxels: 0.93 at 30 and 60 without the correction) widens the corners of the other shapes";
 
 pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
     ExpectedFailure {
@@ -120,7 +128,41 @@ pub(crate) const EXPECTED_FAILURES: &[ExpectedFailure] = &[
         metric: "superball p = 4 at 60 voxels across",
         reason: REASON,
     },
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "minimal bending: sphere at 20 voxels across",
+        reason: BENDING_SPHERE_REASON,
+    },
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "minimal bending: sphere at 30 voxels across",
+        reason: BENDING_SPHERE_REASON,
+    },
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "minimal bending: sphere at 60 voxels across",
+        reason: BENDING_SPHERE_REASON,
+    },
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "minimal bending: rounded cube ρ/a = 0.3 at 20 voxels across",
+        reason: BENDING_REASON,
+    },
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "minimal bending: rounded cube ρ/a = 0.3 at 30 voxels across",
+        reason: BENDING_REASON,
+    },
+    ExpectedFailure {
+        case: "levelset/voxel-roundness",
+        metric: "minimal bending: rounded cube ρ/a = 0.3 at 60 voxels across",
+        reason: BENDING_REASON,
+    },
 ];
+
+/// Prefix of the checks of the minimal-bending extraction
+/// (`levelset::ExtractParams::minimal_bending`), measured beside the image path.
+const BENDING: &str = "minimal bending: ";
 
 fn err(e: impl std::fmt::Display) -> Error {
     Error::Computation {
@@ -222,15 +264,25 @@ pub(crate) fn superball_roundness(p: f64, n: usize) -> f64 {
 /// The shape scaled to `across` voxels across (2a = across·h, h = 1), rotated and placed
 /// off the lattice, as a one-label image.
 fn voxelise(shape: Shape, across: f64) -> Result<LabelImage, Error> {
+    voxelise_posed(
+        shape,
+        across,
+        Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(1.0, 2.0, 3.0)), 0.5),
+        Vector3::new(0.37, 0.21, 0.13),
+    )
+}
+
+/// [`voxelise`] with the rotation and the centre's offset from the lattice given.
+fn voxelise_posed(
+    shape: Shape,
+    across: f64,
+    rot: Rotation3<f64>,
+    offset: Vector3<f64>,
+) -> Result<LabelImage, Error> {
     let a = 0.5 * across;
-    let rot = Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(1.0, 2.0, 3.0)), 0.5);
     let inv = rot.inverse();
     let n = (2.0 * a * 3f64.sqrt()).ceil() as usize + 8;
-    let centre = Point3::new(
-        0.5 * n as f64 + 0.37,
-        0.5 * n as f64 + 0.21,
-        0.5 * n as f64 + 0.13,
-    );
+    let centre = Point3::from(Vector3::repeat(0.5 * n as f64) + offset);
     let mut image = LabelImage::zeros([n, n, n], 1.0).map_err(err)?;
     for k in 0..n {
         for j in 0..n {
@@ -259,24 +311,33 @@ fn voxel_roundness() -> Result<Vec<Check>, Error> {
         let reference = shape.reference();
         for across in [20.0, 30.0, 60.0] {
             let image = voxelise(shape, across)?;
-            let ex = image.extract(&ExtractParams::voxel_images()).map_err(err)?;
-            let grain = ex
-                .grains
-                .first()
-                .ok_or_else(|| err("the grain was not extracted"))?;
-            let r = morph_dna::measure(
-                &grain.grid,
-                &[Descriptor::Roundness],
-                &MeasureParams::voxel_images(),
-            )
-            .map_err(err)?[0];
-            let tol = if across < 25.0 { 0.10 } else { 0.05 };
-            checks.push(Check::new(
-                format!("{} at {across} voxels across", shape.name()),
-                reference,
-                r,
-                Tolerance::Relative(tol),
-            ));
+            for (method, params, measure) in [
+                (
+                    "",
+                    ExtractParams::voxel_images(),
+                    MeasureParams::voxel_images(),
+                ),
+                (
+                    BENDING,
+                    ExtractParams::minimal_bending(),
+                    MeasureParams::minimal_bending(),
+                ),
+            ] {
+                let ex = image.extract(&params).map_err(err)?;
+                let grain = ex
+                    .grains
+                    .first()
+                    .ok_or_else(|| err("the grain was not extracted"))?;
+                let r = morph_dna::measure(&grain.grid, &[Descriptor::Roundness], &measure)
+                    .map_err(err)?[0];
+                let tol = if across < 25.0 { 0.10 } else { 0.05 };
+                checks.push(Check::new(
+                    format!("{method}{} at {across} voxels across", shape.name()),
+                    reference,
+                    r,
+                    Tolerance::Relative(tol),
+                ));
+            }
         }
     }
     Ok(checks)
@@ -301,6 +362,68 @@ mod tests {
             "{r4}"
         );
         assert!(r4 < r3 && r3 < 1.0, "{r3} {r4}");
+    }
+
+    /// The calibration of `morph_dna::BENDING_CORNER_OFFSET`: voxelised analytic grains
+    /// that `levelset/voxel-roundness` does not use (rounded cubes ρ/a = 0.4, 0.6 and
+    /// superballs p = 2.5, 3.5 at 25, 40 and 50 voxels across, another rotation and
+    /// lattice offset), extracted with `ExtractParams::minimal_bending`; the offset on a
+    /// 0.1-voxel grid in [0, 1.5] that minimises the RMS relative error against the closed
+    /// forms is the constant (measured: 0.8, RMS 3.96 %; 0.7 and 0.9: 4.09 % and 4.12 %;
+    /// no correction: 9.45 %). Slow in the test profile: `cargo test --release -p validate -- --ignored
+    /// bending_offset_calibration --nocapture`.
+    #[test]
+    #[ignore = "calibration sweep: run in release with --ignored"]
+    #[allow(clippy::print_stdout, reason = "the calibration table")]
+    fn bending_offset_calibration() {
+        let shapes = [
+            Shape::RoundedCube { rho: 0.4 },
+            Shape::RoundedCube { rho: 0.6 },
+            Shape::Superball { p: 2.5 },
+            Shape::Superball { p: 3.5 },
+        ];
+        let offsets: Vec<f64> = (0..=15).map(|i| f64::from(i) * 0.1).collect();
+        let mut errors = vec![Vec::new(); offsets.len()];
+        let rot =
+            Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(3.0, 1.0, 2.0)), 0.9);
+        for shape in shapes {
+            let reference = shape.reference();
+            for across in [25.0, 40.0, 50.0] {
+                let image = voxelise_posed(shape, across, rot, Vector3::new(0.11, 0.47, 0.29))
+                    .expect("image");
+                let ex = image
+                    .extract(&ExtractParams::minimal_bending())
+                    .expect("extract");
+                let grid = &ex.grains[0].grid;
+                let mut line = format!("{} at {across}:", shape.name());
+                for (o, e) in offsets.iter().zip(errors.iter_mut()) {
+                    let p = MeasureParams {
+                        corner_radius_offset: *o,
+                        ..MeasureParams::minimal_bending()
+                    };
+                    let r = morph_dna::measure(grid, &[Descriptor::Roundness], &p).expect("r")[0];
+                    e.push(r / reference - 1.0);
+                    line += &format!(" {o:.1}: {:+.1} %", 100.0 * (r / reference - 1.0));
+                }
+                println!("{line}");
+            }
+        }
+        let rms: Vec<f64> = errors
+            .iter()
+            .map(|e| (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt())
+            .collect();
+        let best = (0..rms.len())
+            .min_by(|&a, &b| rms[a].total_cmp(&rms[b]))
+            .expect("offsets");
+        for (o, r) in offsets.iter().zip(&rms) {
+            println!("offset {o:.1}: RMS {:.2} %", 100.0 * r);
+        }
+        assert!(
+            (offsets[best] - morph_dna::BENDING_CORNER_OFFSET).abs() < 1e-9,
+            "calibrated {} against the constant {}",
+            offsets[best],
+            morph_dna::BENDING_CORNER_OFFSET
+        );
     }
 
     /// The rounded cube's inside test against its closed form (face, edge, corner).

@@ -1,0 +1,219 @@
+//! Sign-constrained minimal-bending refinement of a voxel grain's level set
+//! ([`Bending`], [`ExtractParams::bending`](super::ExtractParams::bending)).
+//!
+//! Method (after Lempitsky 2010, "Surface extraction from binary volumes with higher-order
+//! smoothness", CVPR, doi:10.1109/CVPR.2010.5539832): among all functions φ on the voxel
+//! lattice that keep the side of every voxel centre (φ ≤ 0 at the grain's voxels, φ ≥ 0
+//! elsewhere), take the one of least bending energy
+//!
+//! ```text
+//! E(φ) = Σ_nodes ‖H_h φ‖²_F = Σ_q Σ_a (δ²_a φ)(q)² + 2 Σ_cells Σ_{a<b} (δ_a δ_b φ)²,
+//! ```
+//!
+//! the discrete Frobenius norm of the Hessian (second differences along each axis at the
+//! nodes, mixed differences on the cells; the mixed terms make it rotation invariant to
+//! second order, so no axis is preferred). Its gradient is `2 Δ_h² φ` (the 25-point
+//! biharmonic stencil `2 (Σ_a δ⁴_a + 2 Σ_{a<b} δ²_a δ²_b)`, applied as two 7-point
+//! Laplacians). A surface that passes between
+//! the voxel centres with the least curvature variation has no staircase, and unlike a
+//! blur it cannot drift off the voxels: every voxel stays on its side.
+//!
+//! Choices the paper leaves open, and why:
+//!
+//! * **Unknowns and scale.** Only the nodes with |φ₀| ≤ `band` voxels (φ₀ the level set
+//!   the extraction built: the EDT or the σ-blurred one) and at least 2 nodes from the crop
+//!   border are free; the others keep φ₀. The fixed shell sets the scale of φ (without it
+//!   φ = 0 would be optimal) and keeps the solve local. `band = 3` is the measured optimum
+//!   on a voxelised sphere, superballs and rounded cubes (2: the shell's staircase reaches
+//!   the surface; 4–6: corners rounded further, see the module docs of [`crate::labels`]).
+//! * **Solver.** Projected gradient with Nesterov acceleration and gradient-based adaptive
+//!   restart (FISTA; Beck & Teboulle 2009; O'Donoghue & Candès 2015): the constraints are
+//!   bounds, so the projection is a clamp; the step is `1/L` with `L = 2·12² = 288`, the
+//!   largest eigenvalue of `2 Δ_h²`. It stops when no value moves by more than `tolerance`
+//!   voxels in an iteration (50 and 1000 fixed iterations gave the same roundness on the
+//!   analytic grains). The result is then redistanced by fast sweeping (the sign of every
+//!   node kept), so the grid is a signed distance again.
+//! * **Constraint margin 0.** The surface may touch a voxel centre. A positive margin keeps
+//!   it away from the centres and brings the staircase back (a voxelised sphere reads
+//!   roundness 0.64 with a margin of 0.15 voxel against 0.90 without).
+//!
+//! Everything is serial and deterministic per grain.
+
+use crate::error::{Error, Result};
+
+/// Parameters of the minimal-bending refinement (module docs of [`crate::labels`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bending {
+    /// Half-width of the refined band, in voxels: nodes with |φ₀| ≤ `band` are free, the
+    /// others keep the extraction's value. Default 3 (in [1, 16]).
+    pub band: f64,
+    /// Iteration cap of the accelerated projected gradient. Default 200 (in [1, 100 000]).
+    pub max_iterations: usize,
+    /// Convergence: stop when no free value moves by more than this many voxels in one
+    /// iteration. Default 3e-3 (in (0, 1]): the roundness of the analytic grains and clones
+    /// of the module docs reads within 0.5 % of a 1e-4 stop, at 0.4 times the cost.
+    pub tolerance: f64,
+}
+
+impl Default for Bending {
+    fn default() -> Self {
+        Self {
+            band: 3.0,
+            max_iterations: 200,
+            tolerance: 3e-3,
+        }
+    }
+}
+
+impl Bending {
+    /// Checks the parameters.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a band outside [1, 16] voxels, an iteration cap
+    /// outside [1, 100 000] or a tolerance outside (0, 1].
+    pub fn validate(&self) -> Result<()> {
+        if !(self.band.is_finite() && (1.0..=16.0).contains(&self.band)) {
+            return Err(Error::InvalidParameter {
+                name: "bending.band",
+                value: self.band,
+                requirement: "1 ..= 16 voxels",
+            });
+        }
+        if !(1..=100_000).contains(&self.max_iterations) {
+            return Err(Error::InvalidParameter {
+                name: "bending.max_iterations",
+                value: self.max_iterations as f64,
+                requirement: "1 ..= 100000",
+            });
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance <= 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "bending.tolerance",
+                value: self.tolerance,
+                requirement: "in (0, 1] voxels",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// What one refinement did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BendingRun {
+    /// Iterations taken.
+    pub iterations: usize,
+    /// Whether the tolerance was reached before the cap.
+    pub converged: bool,
+}
+
+/// How far below zero an inside voxel centre is held, in voxels (only so that a touching
+/// surface keeps the strict sign `φ < 0` of the grid's inside).
+const INSIDE_GAP: f64 = 1e-9;
+
+/// Largest eigenvalue of the gradient operator `2 Δ_h²` on the unit lattice (`2 · 12²`).
+const LIPSCHITZ: f64 = 288.0;
+
+/// Refines `values` (a level set on the `dims` lattice with `spacing`, nodes at voxel
+/// centres) in place: the minimal-bending φ of the module docs with `inside[p]` ⇔ φ ≤ 0.
+/// The caller redistances afterwards.
+pub(crate) fn refine(
+    values: &mut [f64],
+    inside: &[bool],
+    dims: [usize; 3],
+    spacing: f64,
+    params: &Bending,
+) -> BendingRun {
+    let [nx, ny, nz] = dims;
+    let n = nx * ny * nz;
+    debug_assert_eq!(values.len(), n);
+    debug_assert_eq!(inside.len(), n);
+    let (sy, sz) = (nx, nx * ny);
+    // Free nodes (at least 2 from the border: the stencil reaches 2 nodes along an axis).
+    let mut free: Vec<usize> = Vec::new();
+    if nx >= 5 && ny >= 5 && nz >= 5 {
+        for k in 2..nz - 2 {
+            for j in 2..ny - 2 {
+                let row = nx * (j + ny * k);
+                for i in 2..nx - 2 {
+                    let p = row + i;
+                    if (values[p] / spacing).abs() <= params.band {
+                        free.push(p);
+                    }
+                }
+            }
+        }
+    }
+    if free.is_empty() {
+        return BendingRun {
+            iterations: 0,
+            converged: true,
+        };
+    }
+    // Work in voxel units; `x` holds every node (fixed ones keep φ₀).
+    let mut x: Vec<f64> = values.iter().map(|v| v / spacing).collect();
+    let sign: Vec<bool> = free.iter().map(|&p| inside[p]).collect();
+    // Inside: φ ≤ −INSIDE_GAP (the grid's inside is φ < 0, so a voxel the surface touches
+    // stays inside); outside: φ ≥ 0.
+    let clamp = |v: f64, ins: bool| if ins { v.min(-INSIDE_GAP) } else { v.max(0.0) };
+    for (&p, &ins) in free.iter().zip(&sign) {
+        x[p] = clamp(x[p], ins);
+    }
+    // y: the extrapolated point (same fixed values); xn: the new iterate at free nodes.
+    let mut y = x.clone();
+    let mut xn = vec![0.0; free.len()];
+    let mut t = 1.0f64;
+    let mut run = BendingRun {
+        iterations: 0,
+        converged: false,
+    };
+    // Δ_h y is needed at the free nodes and their 6 neighbours (Δ_h² = Δ_h Δ_h, exactly
+    // Σ δ⁴_a + 2 Σ δ²_a δ²_b): two 7-point passes instead of one 25-point stencil.
+    let mut mark = vec![false; n];
+    for &p in &free {
+        for q in [p, p - 1, p + 1, p - sy, p + sy, p - sz, p + sz] {
+            mark[q] = true;
+        }
+    }
+    let lap_nodes: Vec<usize> = (0..n).filter(|&q| mark[q]).collect();
+    drop(mark);
+    let mut lap = vec![0.0; n];
+    let laplacian = |y: &[f64], p: usize| -> f64 {
+        y[p - 1] + y[p + 1] + y[p - sy] + y[p + sy] + y[p - sz] + y[p + sz] - 6.0 * y[p]
+    };
+    for it in 0..params.max_iterations {
+        let mut dot = 0.0;
+        let mut moved = 0.0f64;
+        for &q in &lap_nodes {
+            lap[q] = laplacian(&y, q);
+        }
+        for (q, (&p, &ins)) in free.iter().zip(&sign).enumerate() {
+            let v = clamp(y[p] - 2.0 * laplacian(&lap, p) / LIPSCHITZ, ins);
+            xn[q] = v;
+            dot += (y[p] - v) * (v - x[p]);
+            moved = moved.max((v - x[p]).abs());
+        }
+        // Adaptive restart (O'Donoghue & Candès 2015): drop the momentum when it points
+        // uphill.
+        let (tn, beta) = if dot > 0.0 {
+            (1.0, 0.0)
+        } else {
+            let tn = 0.5 * (1.0 + (1.0 + 4.0 * t * t).sqrt());
+            (tn, (t - 1.0) / tn)
+        };
+        for (q, &p) in free.iter().enumerate() {
+            let v = xn[q];
+            y[p] = v + beta * (v - x[p]);
+            x[p] = v;
+        }
+        t = tn;
+        run.iterations = it + 1;
+        if moved <= params.tolerance {
+            run.converged = true;
+            break;
+        }
+    }
+    for &p in &free {
+        values[p] = x[p] * spacing;
+    }
+    run
+}
