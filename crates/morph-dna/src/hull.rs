@@ -319,6 +319,11 @@ fn quickhull(points: &[Point3<f64>], rel_eps: f64) -> Result<Vec<[usize; 3]>> {
             for k in 0..3 {
                 let nb = fs.faces[f].nb[k];
                 let n = nb as usize;
+                if !fs.faces[n].alive {
+                    // adjacency left pointing at a deleted face: an earlier horizon was
+                    // inconsistent in a way its checks missed
+                    return Err(degenerate(NUMERICALLY_DEGENERATE));
+                }
                 if stamp[n] != iteration {
                     stamp[n] = iteration;
                     seen_visible[n] = in_region[n] || fs.planes[n].distance(&ep) > eps;
@@ -350,14 +355,35 @@ fn quickhull(points: &[Point3<f64>], rel_eps: f64) -> Result<Vec<[usize; 3]>> {
                 .ok_or_else(|| degenerate(NUMERICALLY_DEGENERATE))?;
             acr.nb[k] = id;
             new_faces.push(id);
-            // the first horizon edge starting / ending at a point wins
-            if start_stamp[a as usize] != iteration {
-                start_stamp[a as usize] = iteration;
-                starts_at[a as usize] = e as u32;
+            // a visible region that is a topological disk has a horizon that is one simple
+            // loop: every point starts and ends at most one horizon edge. Rounding can make
+            // the region pinched or holed (a point on two loops, or two loops); linking such
+            // a horizon corrupts the adjacency and the conflict lists (found on a smoothed
+            // voxel grain: a conflict list became a cycle), so it is refused here and the
+            // hull is rebuilt with a larger tolerance.
+            if start_stamp[a as usize] == iteration || end_stamp[b as usize] == iteration {
+                return Err(degenerate(NUMERICALLY_DEGENERATE));
             }
-            if end_stamp[b as usize] != iteration {
-                end_stamp[b as usize] = iteration;
-                ends_at[b as usize] = e as u32;
+            start_stamp[a as usize] = iteration;
+            starts_at[a as usize] = e as u32;
+            end_stamp[b as usize] = iteration;
+            ends_at[b as usize] = e as u32;
+        }
+        // one loop through every horizon edge
+        {
+            let mut e = 0usize;
+            for step in 1..=horizon.len() {
+                let b = horizon[e].1 as usize;
+                if start_stamp[b] != iteration {
+                    return Err(degenerate(NUMERICALLY_DEGENERATE));
+                }
+                e = starts_at[b] as usize;
+                if e == 0 && step < horizon.len() {
+                    return Err(degenerate(NUMERICALLY_DEGENERATE));
+                }
+            }
+            if e != 0 {
+                return Err(degenerate(NUMERICALLY_DEGENERATE));
             }
         }
         // link the fan of new faces around the eye
@@ -371,9 +397,16 @@ fn quickhull(points: &[Point3<f64>], rel_eps: f64) -> Result<Vec<[usize; 3]>> {
         }
         // the conflict points of the visible faces, in order, go to the first
         // new face they are outside of (or are inside the hull)
+        // every point is in at most one conflict list, so a longer walk means corrupted
+        // links: refuse rather than loop
+        let mut walked = 0usize;
         for &vf in &visible {
             let mut p = fs.faces[vf as usize].head;
             while p != NONE {
+                walked += 1;
+                if walked > points.len() {
+                    return Err(degenerate(NUMERICALLY_DEGENERATE));
+                }
                 let following = fs.next[p as usize];
                 if p != eye {
                     let pt = &points[p as usize];

@@ -279,6 +279,7 @@ fn load_parents(scene: &Scene, root: &Path) -> anyhow::Result<(Option<cloner::Pa
         keep_border,
         min_voxels,
         smoothing,
+        minimal_bending,
         sh_degree,
         resolution,
     } = &scene.parents
@@ -301,6 +302,7 @@ fn load_parents(scene: &Scene, root: &Path) -> anyhow::Result<(Option<cloner::Pa
         reject_split: false,
         smoothing: *smoothing,
         native_roundness: false,
+        minimal_bending: *minimal_bending,
         sh_degree: *sh_degree,
         resolution: *resolution,
     };

@@ -9,7 +9,8 @@
 //!     // the embedded 71 Ottawa-sand grains (default), or any input of `--parents`:
 //!     // Files(path: "fixtures/grains/vcctl/MA107-6-fine", format: Some(Anm), spacing: None,
 //!     //       raw_dims: None, raw_dtype: None, big_endian: false, keep_border: false,
-//!     //       min_voxels: None, smoothing: None, sh_degree: None, resolution: 45)
+//!     //       min_voxels: None, smoothing: None, minimal_bending: false, sh_degree: None,
+//!     //       resolution: 45)
 //!     parents: Ottawa,
 //!     calibrated: None,            // Some("my-sand.ron"); default fixtures/calibrated/gsc2-ottawa.ron
 //!     clones: Count(200),          // or Graded(count: 200, grading: "uniform:200,400"):
@@ -167,6 +168,10 @@ pub(crate) enum ParentsSpec {
         /// Gaussian smoothing σ in voxels.
         #[serde(default)]
         smoothing: Option<f64>,
+        /// Minimal-bending surfaces and corner correction for labelled images
+        /// (`--minimal-bending`).
+        #[serde(default)]
+        minimal_bending: bool,
         /// Spherical-harmonic degree of `anm` files.
         #[serde(default)]
         sh_degree: Option<usize>,

@@ -51,7 +51,9 @@ pub struct Bending {
     pub max_iterations: usize,
     /// Convergence: stop when no free value moves by more than this many voxels in one
     /// iteration. Default 3e-3 (in (0, 1]): the roundness of the analytic grains and clones
-    /// of the module docs reads within 0.5 % of a 1e-4 stop, at 0.4 times the cost.
+    /// of the module docs reads within 0.6 % of a 1e-4 stop at 0.4 times the cost (65
+    /// iterations on average, 106 at most, over the 2,197 grains of the 512³ synthetic
+    /// scan); 1e-2 halves the iterations but moves the readings by up to 6 %.
     pub tolerance: f64,
 }
 
@@ -216,4 +218,61 @@ pub(crate) fn refine(
         values[p] = x[p] * spacing;
     }
     run
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::{Grid, GridSpec};
+
+    /// Σ ‖H_h φ‖²_F over the interior (the energy of the module docs, voxel units).
+    fn energy(x: &[f64], [nx, ny, nz]: [usize; 3]) -> f64 {
+        let s = [1, nx, nx * ny];
+        let mut e = 0.0;
+        for k in 1..nz - 1 {
+            for j in 1..ny - 1 {
+                for i in 1..nx - 1 {
+                    let p = i + nx * (j + ny * k);
+                    for a in 0..3 {
+                        e += (x[p + s[a]] - 2.0 * x[p] + x[p - s[a]]).powi(2);
+                    }
+                    for (a, b) in [(0, 1), (0, 2), (1, 2)] {
+                        let d = x[p] - x[p + s[a]] - x[p + s[b]] + x[p + s[a] + s[b]];
+                        e += 2.0 * d * d;
+                    }
+                }
+            }
+        }
+        e
+    }
+
+    /// On the EDT of a voxelised sphere (radius 7 voxels, off the lattice): converges
+    /// within the cap, lowers the bending energy, keeps every node's side and leaves the
+    /// nodes outside the band untouched; a grid too small for the stencil is left as is.
+    #[test]
+    fn refine_converges_and_keeps_sides() {
+        let spec = GridSpec::cube(21, -10.0, 10.0).expect("spec");
+        let c = nalgebra::Vector3::new(0.31, -0.17, 0.23);
+        let inside: Vec<bool> = (0..spec.len())
+            .map(|p| {
+                let (i, j, k) = (p % 21, (p / 21) % 21, p / 441);
+                (spec.node(i, j, k).coords - c).norm() < 7.0
+            })
+            .collect();
+        let g = Grid::from_voxels(spec, &inside).expect("edt");
+        let mut v = g.values().to_vec();
+        let run = refine(&mut v, &inside, spec.dims, 1.0, &Bending::default());
+        assert!(run.converged && run.iterations < 200, "{run:?}");
+        assert!(energy(&v, spec.dims) < 0.5 * energy(g.values(), spec.dims));
+        for ((new, old), &ins) in v.iter().zip(g.values()).zip(&inside) {
+            assert_eq!(*new < 0.0, ins);
+            if old.abs() > 3.0 {
+                assert_eq!(new, old);
+            }
+        }
+        let mut small = vec![1.0; 27];
+        let run = refine(&mut small, &[false; 27], [3, 3, 3], 1.0, &Bending::default());
+        assert_eq!((run.iterations, run.converged), (0, true));
+        assert!(small.iter().all(|&x| x == 1.0));
+    }
 }
