@@ -90,6 +90,11 @@ fn benches(c: &mut Criterion) {
     c.bench_function("extract_160_64grains_smoothed_serial", |b| {
         b.iter(|| img.extract(black_box(&serial)).expect("extract"))
     });
+    // issue 31: σ = 0.7 then the minimal-bending refinement (ExtractParams::minimal_bending)
+    let bending = ExtractParams::minimal_bending();
+    c.bench_function("extract_160_64grains_minimal_bending", |b| {
+        b.iter(|| img.extract(black_box(&bending)).expect("extract"))
+    });
     let mut npy = Vec::new();
     write_npy(&mut npy, &img, Dtype::U16).expect("npy");
     c.bench_function("read_npy_u16_160", |b| {

@@ -2,7 +2,7 @@
 //! ([`Bending`], [`ExtractParams::bending`](super::ExtractParams::bending)).
 //!
 //! Method (after Lempitsky 2010, "Surface extraction from binary volumes with higher-order
-//! smoothness", CVPR, doi:10.1109/CVPR.2010.5539832): among all functions φ on the voxel
+//! smoothness", Proc. IEEE CVPR 2010): among all functions φ on the voxel
 //! lattice that keep the side of every voxel centre (φ ≤ 0 at the grain's voxels, φ ≥ 0
 //! elsewhere), take the one of least bending energy
 //!
@@ -271,7 +271,13 @@ mod tests {
             }
         }
         let mut small = vec![1.0; 27];
-        let run = refine(&mut small, &[false; 27], [3, 3, 3], 1.0, &Bending::default());
+        let run = refine(
+            &mut small,
+            &[false; 27],
+            [3, 3, 3],
+            1.0,
+            &Bending::default(),
+        );
         assert_eq!((run.iterations, run.converged), (0, true));
         assert!(small.iter().all(|&x| x == 1.0));
     }
