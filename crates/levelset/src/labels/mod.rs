@@ -108,8 +108,8 @@
 //! rounded cubes ρ/a = 0.5 and superballs p = 3, 4 then read within 4.1 % of their closed
 //! forms at 20–60 voxels across (validate case `levelset/voxel-roundness`). Cost: about 65
 //! accelerated-gradient iterations over the band per grain; on the 512³ synthetic scan
-//! (2,197 grains of 21 voxels across, 2 cores) the level sets take 15.6–17.7 s against
-//! 3.9–4.3 s with σ = 0.7 alone, so it is not the image path's default
+//! (2,197 grains of 21 voxels across, 2 cores) the level sets take 14.7–17.7 s against
+//! 3.2–4.3 s with σ = 0.7 alone, so it is not the image path's default
 //! ([`ExtractParams::voxel_images`]); `cargo xtask dna / calibrate / clone --minimal-bending`
 //! selects it.
 //!
