@@ -387,10 +387,8 @@ fn quickhull(points: &[Point3<f64>], rel_eps: f64) -> Result<Vec<[usize; 3]>> {
             }
         }
         // link the fan of new faces around the eye
+        // (every edge's ends start and end an edge: the loop check above)
         for (i, &(a, b, _)) in horizon.iter().enumerate() {
-            if start_stamp[b as usize] != iteration || end_stamp[a as usize] != iteration {
-                return Err(degenerate(NUMERICALLY_DEGENERATE));
-            }
             let f = new_faces[i] as usize;
             fs.faces[f].nb[1] = new_faces[starts_at[b as usize] as usize];
             fs.faces[f].nb[2] = new_faces[ends_at[a as usize] as usize];

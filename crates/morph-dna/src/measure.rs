@@ -832,22 +832,16 @@ impl<'g> Measurement<'g> {
                         let Some(surface) = &self.surface else {
                             unreachable_state()?
                         };
+                        // the correction is in spacings of the grain's own grid (voxels)
+                        let offset = self.params.corner_radius_offset * self.grid.spacing();
                         let r = match self.params.roundness_grid {
-                            RoundnessGrid::Native => roundness(
-                                &self.grid,
-                                surface.mesh(),
-                                &self.params,
-                                self.params.corner_radius_offset * self.grid.spacing(),
-                            )?,
+                            RoundnessGrid::Native => {
+                                roundness(&self.grid, surface.mesh(), &self.params, offset)?
+                            }
                             RoundnessGrid::Canonical { resolution, margin } => {
                                 let g =
                                     canonical_grid(&self.grid, surface.mesh(), resolution, margin)?;
-                                roundness(
-                                    &g,
-                                    &g.marching_cubes(),
-                                    &self.params,
-                                    self.params.corner_radius_offset * self.grid.spacing(),
-                                )?
+                                roundness(&g, &g.marching_cubes(), &self.params, offset)?
                             }
                         };
                         self.roundness = Some(r);

@@ -392,6 +392,31 @@ fn parallel_and_serial_are_identical_and_sparse_labels_work() {
     assert_eq!(s, t);
 }
 
+/// Relative volume and area errors of an extracted grain `g` against the ellipsoid of
+/// semi-axes `semi` centred at `c` (`analytic`: its grid in its own frame), and the RMS
+/// angle in degrees between the grid's normals and the analytic ones at 300 surface nodes.
+fn surface_errors(
+    g: &Grid,
+    analytic: &Grid,
+    c: Point3<f64>,
+    semi: Vector3<f64>,
+) -> (f64, f64, f64) {
+    let v_exact = 4.0 / 3.0 * PI * semi.x * semi.y * semi.z;
+    let nodes = g.surface_nodes(300).expect("nodes");
+    let mut sq = 0.0;
+    for q in &nodes {
+        let n1 = g.gradient(q).normalize();
+        let n0 = analytic.gradient(&(q - c.coords)).normalize();
+        sq += n1.dot(&n0).clamp(-1.0, 1.0).acos().powi(2);
+    }
+    let normal = (sq / nodes.len() as f64).sqrt().to_degrees();
+    (
+        g.volume() / v_exact - 1.0,
+        g.area() / ellipsoid_area(semi) - 1.0,
+        normal,
+    )
+}
+
 /// Relative volume and area errors of the EDT and the smoothed (σ = 1 voxel) extraction
 /// for voxelised spheres and ellipsoids; the numbers in the module doc come from here.
 #[test]
@@ -417,8 +442,6 @@ fn smoothing_measurement() {
         let semi = semi_vox * h;
         let (img, c) = one_grain(semi, h, rot);
         let analytic = shape_grid(semi, h, rot);
-        let v_exact = 4.0 / 3.0 * PI * semi.x * semi.y * semi.z;
-        let a_exact = ellipsoid_area(semi);
         let mut row = Vec::new();
         for smoothing in [None, Some(1.0), Some(0.7), Some(1.5)] {
             let p = ExtractParams {
@@ -427,17 +450,7 @@ fn smoothing_measurement() {
                 ..ExtractParams::default()
             };
             let ex = img.extract(&p).expect("extract");
-            let g = &ex.grains[0].grid;
-            // RMS angle between the grid normal and the analytic normal at surface nodes.
-            let nodes = g.surface_nodes(300).expect("nodes");
-            let mut sq = 0.0;
-            for q in &nodes {
-                let n1 = g.gradient(q).normalize();
-                let n0 = analytic.gradient(&(q - c.coords)).normalize();
-                sq += n1.dot(&n0).clamp(-1.0, 1.0).acos().powi(2);
-            }
-            let normal = (sq / nodes.len() as f64).sqrt().to_degrees();
-            row.push((g.volume() / v_exact - 1.0, g.area() / a_exact - 1.0, normal));
+            row.push(surface_errors(&ex.grains[0].grid, &analytic, c, semi));
         }
         eprintln!(
             "{:?} | {:+.4} | {:+.4} | {:+.4} | {:+.4} | {:.2} | {:.2} | ({:+.4} {:+.4} {:.2}) ({:+.4} {:+.4} {:.2})",
@@ -601,8 +614,6 @@ fn bending_measurement() {
         let semi = semi_vox * h;
         let (img, c) = one_grain(semi, h, rot);
         let analytic = shape_grid(semi, h, rot);
-        let v_exact = 4.0 / 3.0 * PI * semi.x * semi.y * semi.z;
-        let a_exact = ellipsoid_area(semi);
         let mut row = Vec::new();
         for p in [
             ExtractParams::voxel_images(),
@@ -610,15 +621,7 @@ fn bending_measurement() {
         ] {
             let ex = img.extract(&p).expect("extract");
             let g = &ex.grains[0].grid;
-            let nodes = g.surface_nodes(300).expect("nodes");
-            let mut sq = 0.0;
-            for q in &nodes {
-                let n1 = g.gradient(q).normalize();
-                let n0 = analytic.gradient(&(q - c.coords)).normalize();
-                sq += n1.dot(&n0).clamp(-1.0, 1.0).acos().powi(2);
-            }
-            let normal = (sq / nodes.len() as f64).sqrt().to_degrees();
-            row.push((g.volume() / v_exact - 1.0, g.area() / a_exact - 1.0, normal));
+            row.push(surface_errors(g, &analytic, c, semi));
             if p.bending.is_some() {
                 // every node is a voxel centre: its side is the voxel's
                 let [nx, ny, nz] = g.dims();

@@ -393,12 +393,18 @@ fn measure_dna(grids: &[&levelset::Grid], params: &MeasureParams) -> Result<Vec<
 }
 
 /// A round trip's checks, the clones' own DNA rows and the re-read ones (same order).
-type RoundTrip = (Vec<Check>, Vec<Vec<f64>>, Vec<Vec<f64>>);
+type RoundTrip = (
+    Vec<Check>,
+    Vec<Vec<f64>>,
+    Vec<Vec<f64>>,
+    levelset::LabelImage,
+);
 
 /// Round trip through a labelled image written and read by `write`/`read`, at
 /// `voxels_per_diameter` voxels across the median clone, extracted and measured as the
 /// image path does ([`levelset::ExtractParams::voxel_images`],
-/// [`MeasureParams::voxel_images`]).
+/// [`MeasureParams::voxel_images`]): the checks, the clones' own DNA rows and the re-read
+/// ones (in the extraction's label order), and the image read back.
 fn roundtrip_image(
     voxels_per_diameter: f64,
     write: impl Fn(&levelset::LabelImage) -> Result<Vec<u8>, levelset::Error>,
@@ -433,7 +439,7 @@ fn roundtrip_image(
     let reread = measure_dna(&by_label, &MeasureParams::voxel_images())?;
     let own: Vec<Vec<f64>> = labels.iter().map(|&i| own[i].clone()).collect();
     dna_checks(&mut checks, &own, &reread, h / median(&d), "voxel");
-    Ok((checks, own, reread))
+    Ok((checks, own, reread, back))
 }
 
 /// Index of the roundness in [`cloner::DNA`].
@@ -495,19 +501,16 @@ pub fn ols_slope(x: &[f64], y: &[f64]) -> f64 {
 /// toward the population mean).
 fn roundness_checks(
     checks: &mut Vec<Check>,
-    own: &[Vec<f64>],
-    reread: &[Vec<f64>],
+    x: &[f64],
+    y: &[f64],
     (mean_max, worst_max): (f64, f64),
     ranking: bool,
     prefix: &str,
-) -> Result<(), Error> {
-    let k = roundness_column()?;
-    let x: Vec<f64> = own.iter().map(|r| r[k]).collect();
-    let y: Vec<f64> = reread.iter().map(|r| r[k]).collect();
-    let rel: Vec<f64> = x.iter().zip(&y).map(|(a, b)| ((b - a) / a).abs()).collect();
+) {
+    let rel: Vec<f64> = x.iter().zip(y).map(|(a, b)| ((b - a) / a).abs()).collect();
     let mean = rel.iter().sum::<f64>() / rel.len().max(1) as f64;
     let worst = rel.iter().fold(0.0f64, |a, b| a.max(*b));
-    let bias = x.iter().zip(&y).map(|(a, b)| (b - a) / a).sum::<f64>() / x.len().max(1) as f64;
+    let bias = x.iter().zip(y).map(|(a, b)| (b - a) / a).sum::<f64>() / x.len().max(1) as f64;
     checks.push(Check::new(
         format!(
             "{prefix}roundness mean |rel. error| <= {:.0} %",
@@ -536,17 +539,16 @@ fn roundness_checks(
         checks.push(Check::new(
             format!("{prefix}roundness Spearman rank correlation with the clones' own >= 0.9"),
             0.9,
-            spearman(&x, &y),
+            spearman(x, y),
             Tolerance::AtLeast(0.0),
         ));
         checks.push(Check::new(
             format!("{prefix}roundness slope (voxel on own, least squares) 0.9-1.1"),
             1.0,
-            ols_slope(&x, &y),
+            ols_slope(x, y),
             Tolerance::Within(0.1),
         ));
     }
-    Ok(())
 }
 
 /// The tolerances of the round trips, derived from the resolution `h / D`
@@ -613,55 +615,65 @@ fn roundtrip_npy_at(voxels_per_diameter: f64) -> Result<RoundTrip, Error> {
 }
 
 fn roundtrip_npy() -> Result<Vec<Check>, Error> {
-    let (mut checks, own, reread) = roundtrip_npy_at(ROUNDTRIP_VOXELS_PER_DIAMETER)?;
-    roundness_checks(&mut checks, &own, &reread, (0.05, 0.20), true, "")?;
-    let (own, bent) = bending_roundtrip(ROUNDTRIP_VOXELS_PER_DIAMETER)?;
-    roundness_checks(&mut checks, &own, &bent, (0.05, 0.20), true, BENDING)?;
-    Ok(checks)
+    roundtrip_npy_roundness(ROUNDTRIP_VOXELS_PER_DIAMETER, (0.05, 0.20), true)
 }
 
-/// DNA rows, one per grain ([`cloner::DNA`] order).
-type DnaRows = Vec<Vec<f64>>;
+fn roundtrip_npy_20() -> Result<Vec<Check>, Error> {
+    roundtrip_npy_roundness(20.0, (0.10, 0.40), false)
+}
+
+/// The round trip through `.npy` with the roundness checks of the image path (`ranking`:
+/// also Spearman and slope) and of the minimal-bending path on the same image read back.
+fn roundtrip_npy_roundness(
+    voxels_per_diameter: f64,
+    bounds: (f64, f64),
+    ranking: bool,
+) -> Result<Vec<Check>, Error> {
+    let (mut checks, own, reread, image) = roundtrip_npy_at(voxels_per_diameter)?;
+    let k = roundness_column()?;
+    let column = |rows: &[Vec<f64>]| -> Vec<f64> { rows.iter().map(|r| r[k]).collect() };
+    roundness_checks(
+        &mut checks,
+        &column(&own),
+        &column(&reread),
+        bounds,
+        ranking,
+        "",
+    );
+    let (own, bent) = bending_roundness(&image)?;
+    roundness_checks(&mut checks, &own, &bent, bounds, true, BENDING);
+    Ok(checks)
+}
 
 /// Prefix of the round-trip checks of the minimal-bending extraction
 /// (`levelset::ExtractParams::minimal_bending`), measured beside the image path.
 const BENDING: &str = "minimal bending: ";
 
-/// The clones' own DNA rows and the roundness (in the same column, other columns NaN) of
-/// the same lattice image extracted with `levelset::ExtractParams::minimal_bending` and
-/// measured with `morph_dna::MeasureParams::minimal_bending`.
-fn bending_roundtrip(voxels_per_diameter: f64) -> Result<(DnaRows, DnaRows), Error> {
-    let (grids, own) = roundtrip_clones()?;
-    let d: Vec<f64> = own.iter().map(|r| r[1]).collect();
-    let h = median(&d) / voxels_per_diameter;
-    let image = paint_lattice(grids, h, 3)?;
+/// The clones' own roundness and that of the grains of the round trip's `image` (label
+/// `i + 1` is clone `i`) extracted with `levelset::ExtractParams::minimal_bending` and
+/// measured with `morph_dna::MeasureParams::minimal_bending`, in the extraction's order.
+fn bending_roundness(image: &levelset::LabelImage) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    let (_, own) = roundtrip_clones()?;
+    let k = roundness_column()?;
     let ex = image
         .extract(&levelset::ExtractParams::minimal_bending())
         .map_err(err)?;
-    let k = roundness_column()?;
-    let mut rows_own = Vec::new();
-    let mut rows = Vec::new();
+    let mut x = Vec::with_capacity(ex.grains.len());
+    let mut y = Vec::with_capacity(ex.grains.len());
     for g in &ex.grains {
-        let r = morph_dna::measure(
-            &g.grid,
-            &[Descriptor::Roundness],
-            &MeasureParams::minimal_bending(),
-        )
-        .map_err(err)?[0];
-        let mut row = vec![f64::NAN; cloner::DNA.len()];
-        row[k] = r;
-        rows.push(row);
-        rows_own.push(own[g.label as usize - 1].clone());
+        let i = g.label as usize - 1;
+        let row = own.get(i).ok_or_else(|| err("a label without its clone"))?;
+        x.push(row[k]);
+        y.push(
+            morph_dna::measure(
+                &g.grid,
+                &[Descriptor::Roundness],
+                &MeasureParams::minimal_bending(),
+            )
+            .map_err(err)?[0],
+        );
     }
-    Ok((rows_own, rows))
-}
-
-fn roundtrip_npy_20() -> Result<Vec<Check>, Error> {
-    let (mut checks, own, reread) = roundtrip_npy_at(20.0)?;
-    roundness_checks(&mut checks, &own, &reread, (0.10, 0.40), false, "")?;
-    let (own, bent) = bending_roundtrip(20.0)?;
-    roundness_checks(&mut checks, &own, &bent, (0.10, 0.40), true, BENDING)?;
-    Ok(checks)
+    Ok((x, y))
 }
 
 fn roundtrip_tiff() -> Result<Vec<Check>, Error> {
