@@ -11,6 +11,8 @@ mod packer_quadtree;
 pub mod parents;
 mod perez_morales;
 mod rounding;
+#[cfg(test)]
+mod roundness_ambiguity;
 pub mod specimen;
 mod specimen_dem;
 mod sph_harmonics;
