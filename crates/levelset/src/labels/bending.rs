@@ -153,13 +153,35 @@ pub(crate) fn refine(
     }
     // Work in voxel units; `x` holds every node (fixed ones keep φ₀).
     let mut x: Vec<f64> = values.iter().map(|v| v / spacing).collect();
-    let sign: Vec<bool> = free.iter().map(|&p| inside[p]).collect();
     // Inside: φ ≤ −INSIDE_GAP (the grid's inside is φ < 0, so a voxel the surface touches
-    // stays inside); outside: φ ≥ 0.
-    let clamp = |v: f64, ins: bool| if ins { v.min(-INSIDE_GAP) } else { v.max(0.0) };
-    for (&p, &ins) in free.iter().zip(&sign) {
-        x[p] = clamp(x[p], ins);
+    // stays inside); outside: φ ≥ 0. As bounds, so that the clamp is branch-free:
+    // `v.min(hi).max(lo)` is `v.min(−INSIDE_GAP)` inside and `v.max(0)` outside.
+    let (lo, hi): (Vec<f64>, Vec<f64>) = free
+        .iter()
+        .map(|&p| {
+            if inside[p] {
+                (f64::NEG_INFINITY, -INSIDE_GAP)
+            } else {
+                (0.0, f64::INFINITY)
+            }
+        })
+        .unzip();
+    for (q, &p) in free.iter().enumerate() {
+        x[p] = x[p].min(hi[q]).max(lo[q]);
     }
+    // The free nodes as runs along x (`free` is in lattice order): (first node, length,
+    // index of the first in `free`). Contiguous runs let the stencils vectorise.
+    let runs = |nodes: &[usize]| -> Vec<(usize, usize, usize)> {
+        let mut out: Vec<(usize, usize, usize)> = Vec::new();
+        for (q, &p) in nodes.iter().enumerate() {
+            match out.last_mut() {
+                Some((first, len, _)) if *first + *len == p => *len += 1,
+                _ => out.push((p, 1, q)),
+            }
+        }
+        out
+    };
+    let free_runs = runs(&free);
     // y: the extrapolated point (same fixed values); xn: the new iterate at free nodes.
     let mut y = x.clone();
     let mut xn = vec![0.0; free.len()];
@@ -178,21 +200,35 @@ pub(crate) fn refine(
     }
     let lap_nodes: Vec<usize> = (0..n).filter(|&q| mark[q]).collect();
     drop(mark);
+    let lap_runs = runs(&lap_nodes);
+    drop(lap_nodes);
     let mut lap = vec![0.0; n];
-    let laplacian = |y: &[f64], p: usize| -> f64 {
-        y[p - 1] + y[p + 1] + y[p - sy] + y[p + sy] + y[p - sz] + y[p + sz] - 6.0 * y[p]
+    let longest = free_runs.iter().map(|r| r.1).max().unwrap_or(0);
+    let mut step = vec![0.0; longest];
+    // The 7-point Laplacian of `src` at nodes `first..first + out.len()` into `out` (one
+    // expression per node, in this order: the same rounding as node by node).
+    let laplacian = |src: &[f64], first: usize, out: &mut [f64]| {
+        for (o, p) in out.iter_mut().zip(first..) {
+            *o = src[p - 1] + src[p + 1] + src[p - sy] + src[p + sy] + src[p - sz] + src[p + sz]
+                - 6.0 * src[p];
+        }
     };
     for it in 0..params.max_iterations {
         let mut dot = 0.0;
         let mut moved = 0.0f64;
-        for &q in &lap_nodes {
-            lap[q] = laplacian(&y, q);
+        for &(first, len, _) in &lap_runs {
+            laplacian(&y, first, &mut lap[first..first + len]);
         }
-        for (q, (&p, &ins)) in free.iter().zip(&sign).enumerate() {
-            let v = clamp(y[p] - 2.0 * laplacian(&lap, p) / LIPSCHITZ, ins);
-            xn[q] = v;
-            dot += (y[p] - v) * (v - x[p]);
-            moved = moved.max((v - x[p]).abs());
+        for &(first, len, q0) in &free_runs {
+            let g = &mut step[..len];
+            laplacian(&lap, first, g);
+            for (dq, gv) in g.iter().enumerate() {
+                let (p, q) = (first + dq, q0 + dq);
+                let v = (y[p] - 2.0 * gv / LIPSCHITZ).min(hi[q]).max(lo[q]);
+                xn[q] = v;
+                dot += (y[p] - v) * (v - x[p]);
+                moved = moved.max((v - x[p]).abs());
+            }
         }
         // Adaptive restart (O'Donoghue & Candès 2015): drop the momentum when it points
         // uphill.
@@ -202,10 +238,13 @@ pub(crate) fn refine(
             let tn = 0.5 * (1.0 + (1.0 + 4.0 * t * t).sqrt());
             (tn, (t - 1.0) / tn)
         };
-        for (q, &p) in free.iter().enumerate() {
-            let v = xn[q];
-            y[p] = v + beta * (v - x[p]);
-            x[p] = v;
+        for &(first, len, q0) in &free_runs {
+            let ys = &mut y[first..first + len];
+            let xs = &mut x[first..first + len];
+            for ((yv, xv), &v) in ys.iter_mut().zip(xs.iter_mut()).zip(&xn[q0..q0 + len]) {
+                *yv = v + beta * (v - *xv);
+                *xv = v;
+            }
         }
         t = tn;
         run.iterations = it + 1;
