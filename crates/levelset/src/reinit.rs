@@ -16,6 +16,14 @@
 //!   change-tracking variant: after the 8th sweep no value changed, for the sphere, the
 //!   ellipsoid and a lumpy star grain on 45³ grids; the tests compare against exact
 //!   distances.
+//!
+//! Beyond the seeds, two orderings that change no value: each sweep visits a z-slab's
+//! diagonals (independent nodes, Detrixhe, Gibou & Min 2013), and a node is recomputed only
+//! when a neighbour decreased since its last update (locking, Bak, McLaughlin & Renzi
+//! 2010). After a blur most nodes still move in every sweep (85 % in the first, 30 % in the
+//! eighth, on the grains of the 512³ synthetic scan), so locking saves about 4 % of the
+//! `dna` stage; the test `locked_sweeps_match_plain_sweeps` checks both against plain
+//! lexicographic sweeps.
 
 use crate::error::{Error, Result};
 use crate::grid::{Grid, GridSpec};
