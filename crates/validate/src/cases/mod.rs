@@ -11,11 +11,11 @@ mod packer_quadtree;
 pub mod parents;
 mod perez_morales;
 mod rounding;
-#[cfg(test)]
-mod roundness_ambiguity;
 pub mod specimen;
 mod specimen_dem;
 mod sph_harmonics;
+#[cfg(test)]
+mod tests;
 mod voxel_roundness;
 
 /// Every registered case, in a stable order.

@@ -203,7 +203,7 @@ fn roundtrip_setup() -> (CloneModel, Vec<Vec<f64>>, f64) {
     let parents = crate::grains::ottawa_parents().expect("parents");
     let model = CloneModel::fit(&parents, &params).expect("model");
     let run = model
-        .run(0..super::parents::ROUNDTRIP_CLONES, Hooks::default())
+        .run(0..crate::cases::parents::ROUNDTRIP_CLONES, Hooks::default())
         .expect("clones");
     let k = cloner::DNA
         .iter()
@@ -214,7 +214,8 @@ fn roundtrip_setup() -> (CloneModel, Vec<Vec<f64>>, f64) {
         .iter()
         .map(|c| c.dna.as_ref().expect("dna")[k])
         .collect();
-    let h = super::parents::median(&diameters) / super::parents::ROUNDTRIP_VOXELS_PER_DIAMETER;
+    let h = crate::cases::parents::median(&diameters)
+        / crate::cases::parents::ROUNDTRIP_VOXELS_PER_DIAMETER;
     let radii = run.clones.into_iter().map(|c| c.radii).collect();
     (model, radii, h)
 }
@@ -259,7 +260,7 @@ fn roundtrip_ambiguity() {
 #[ignore = "search over radii, about 40 minutes: run in release with --ignored"]
 #[allow(clippy::print_stdout, reason = "the summary")]
 fn roundtrip_ambiguity_all() {
-    let bounds = least_worst_errors(0..super::parents::ROUNDTRIP_CLONES as usize);
+    let bounds = least_worst_errors(0..crate::cases::parents::ROUNDTRIP_CLONES as usize);
     let mean = bounds.iter().sum::<f64>() / bounds.len() as f64;
     let worst = bounds.iter().fold(0.0f64, |a, b| a.max(*b));
     println!(

@@ -1,0 +1,3 @@
+//! Test-only studies of the cases (slow, ignored by default).
+
+mod roundness_ambiguity;
