@@ -340,23 +340,30 @@ pub const ROUNDTRIP_VOXELS_PER_DIAMETER: f64 = 30.0;
 /// Level sets of clones and their own DNA rows.
 type GridsAndDna = (Vec<levelset::Grid>, Vec<Vec<f64>>);
 
+/// The clone model of the round trips (the calibrated Ottawa configuration, level sets and
+/// DNA on) and its first [`ROUNDTRIP_CLONES`] clones.
+pub(crate) fn roundtrip_model() -> Result<(cloner::CloneModel, cloner::Run), Error> {
+    let text = crate::fixtures::calibrated("gsc2-ottawa.ron")?;
+    let cal = cloner::Calibrated::from_ron(text).map_err(err)?;
+    let mut params = cal.params;
+    params.outputs = cloner::Outputs {
+        level_set: true,
+        dna: true,
+    };
+    let parents = grains::ottawa_parents()?;
+    let model = cloner::CloneModel::fit(&parents, &params).map_err(err)?;
+    let run = model
+        .run(0..ROUNDTRIP_CLONES, cloner::Hooks::default())
+        .map_err(err)?;
+    Ok((model, run))
+}
+
 fn roundtrip_clones() -> Result<&'static GridsAndDna, Error> {
     static CLONES: std::sync::OnceLock<Result<GridsAndDna, String>> = std::sync::OnceLock::new();
     CLONES
         .get_or_init(|| {
             let run = || -> Result<GridsAndDna, Error> {
-                let text = crate::fixtures::calibrated("gsc2-ottawa.ron")?;
-                let cal = cloner::Calibrated::from_ron(text).map_err(err)?;
-                let mut params = cal.params;
-                params.outputs = cloner::Outputs {
-                    level_set: true,
-                    dna: true,
-                };
-                let parents = grains::ottawa_parents()?;
-                let model = cloner::CloneModel::fit(&parents, &params).map_err(err)?;
-                let run = model
-                    .run(0..ROUNDTRIP_CLONES, cloner::Hooks::default())
-                    .map_err(err)?;
+                let (_, run) = roundtrip_model()?;
                 let mut grids = Vec::new();
                 let mut dna = Vec::new();
                 for c in run.clones {

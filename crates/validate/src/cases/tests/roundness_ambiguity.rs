@@ -18,7 +18,7 @@
 //! taken only if the image is unchanged (halving it up to 8 times otherwise) and the own
 //! roundness moved the right way. Three programs per direction.
 
-use cloner::{CloneModel, Hooks};
+use cloner::CloneModel;
 use levelset::nalgebra::{DMatrix, DVector, Vector3};
 use levelset::{Grid, LabelImage};
 use morph_dna::{Descriptor, MeasureParams};
@@ -193,18 +193,7 @@ fn identical_image_interval(model: &CloneModel, r0: &[f64], h: f64) -> (f64, f64
 /// The round trips' clone model, their clones and the voxel size at 30 voxels per median
 /// diameter.
 fn roundtrip_setup() -> (CloneModel, Vec<Vec<f64>>, f64) {
-    let text = crate::fixtures::calibrated("gsc2-ottawa.ron").expect("fixture");
-    let cal = cloner::Calibrated::from_ron(text).expect("calibration");
-    let mut params = cal.params;
-    params.outputs = cloner::Outputs {
-        level_set: true,
-        dna: true,
-    };
-    let parents = crate::grains::ottawa_parents().expect("parents");
-    let model = CloneModel::fit(&parents, &params).expect("model");
-    let run = model
-        .run(0..crate::cases::parents::ROUNDTRIP_CLONES, Hooks::default())
-        .expect("clones");
+    let (model, run) = crate::cases::parents::roundtrip_model().expect("round-trip clones");
     let k = cloner::DNA
         .iter()
         .position(|d| *d == Descriptor::EquivalentDiameter)
